@@ -1,0 +1,203 @@
+"""The unit cell: lattice, admissible design space, nominal area (paper sec. 2.2 and 4.1).
+
+N = n * n asperities sit on an n x n square lattice, asperity k in lattice cell (k // n, k % n).
+Each owns a square of side 4 a_max, where a_max is the largest contact radius reachable in the
+admissible space (gamma in [gamma_min, gamma_max], h = 0, Delta = Delta_max); so the cell side
+is L = 4 n a_max and A_nom = L^2. Lengths are in the unit of R (R = 1 in the core).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, replace
+from typing import Any
+
+import numpy as np
+import torch
+
+from metainterface.errors import MetainterfaceError
+from metainterface.physics.sneddon import contact_radius
+
+# Resolution of the gamma scan that finds a_max; the maximum is at an end point for all
+# practical settings, the scan only guards against exotic ones (Delta_max ~ R).
+_A_MAX_SCAN = 4097
+
+
+def _finite(name: str, value: float, *, low: float | None = None, strict: bool = True) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise MetainterfaceError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(value):
+        raise MetainterfaceError(f"{name} must be finite, got {value}")
+    if low is not None and (value <= low if strict else value < low):
+        raise MetainterfaceError(f"{name} must be {'>' if strict else '>='} {low}, got {value}")
+    return value
+
+
+@dataclass(frozen=True)
+class CellSettings:
+    """Everything that fixes the cell and its curves. Validated on construction.
+
+    n_asperities: N, a perfect square (1, 4, 9, 16, ...).
+    radius: R, the base radius shared by all shapes [length; 1 in the dimensionless core].
+    e_star: E*, the equivalent modulus [pressure; 1 in the dimensionless core].
+    delta_max: largest global indentation Delta_max [length]; the paper uses R / 50.
+    gamma_min, gamma_max: admissible shape exponents, 1 < gamma_min < gamma_max.
+    n_steps: points of the uniform pressure grid (and of the Delta sweep) of a curve.
+    """
+
+    n_asperities: int = 9
+    radius: float = 1.0
+    e_star: float = 1.0
+    delta_max: float = 0.02
+    gamma_min: float = 1.8
+    gamma_max: float = 4.0
+    n_steps: int = 128
+
+    def __post_init__(self) -> None:
+        n = self.n_asperities
+        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+            raise MetainterfaceError(f"n_asperities must be a positive perfect square, got {n!r}")
+        if math.isqrt(int(n)) ** 2 != n:
+            raise MetainterfaceError(
+                f"n_asperities must be a perfect square (1, 4, 9, 16, ...), got {n}"
+            )
+        object.__setattr__(self, "n_asperities", int(n))
+        for name in ("radius", "e_star", "delta_max"):
+            object.__setattr__(self, name, _finite(name, getattr(self, name), low=0.0))
+        gmin = _finite("gamma_min", self.gamma_min, low=1.0)
+        gmax = _finite("gamma_max", self.gamma_max, low=1.0)
+        if gmax <= gmin:
+            raise MetainterfaceError(
+                f"gamma bounds must satisfy 1 < gamma_min < gamma_max, got [{gmin}, {gmax}]"
+            )
+        object.__setattr__(self, "gamma_min", gmin)
+        object.__setattr__(self, "gamma_max", gmax)
+        steps = self.n_steps
+        if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 2:
+            raise MetainterfaceError(f"n_steps must be an integer >= 2, got {steps!r}")
+        object.__setattr__(self, "n_steps", int(steps))
+
+    @property
+    def n_side(self) -> int:
+        """n, the lattice side: N = n * n."""
+        return math.isqrt(self.n_asperities)
+
+    @property
+    def a_max(self) -> float:
+        """Largest contact radius reachable in the admissible space [length]."""
+        gammas = torch.linspace(self.gamma_min, self.gamma_max, _A_MAX_SCAN, dtype=torch.float64)
+        delta = torch.full_like(gammas, self.delta_max)
+        return float(contact_radius(gammas, delta, self.radius).max())
+
+    @property
+    def cell_side(self) -> float:
+        """L = 4 n a_max [length]."""
+        return 4.0 * self.n_side * self.a_max
+
+    @property
+    def nominal_area(self) -> float:
+        """A_nom = L^2 [length^2]."""
+        return self.cell_side**2
+
+    def lattice_centres(self) -> np.ndarray:
+        """(N, 2) centres (x, y) of the asperities' squares, asperity k in cell (k // n, k % n).
+
+        Row index k // n runs along y, column index k % n along x [length].
+        """
+        n = self.n_side
+        pitch = self.cell_side / n
+        k = np.arange(self.n_asperities)
+        return np.stack([(k % n + 0.5) * pitch, (k // n + 0.5) * pitch], axis=1)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    def with_(self, **changes: Any) -> CellSettings:
+        """A copy with some fields changed (validated again)."""
+        return replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class Design:
+    """One unit-cell design: shape exponents and height offsets of its N asperities.
+
+    gamma: (N,) shape exponents in [gamma_min, gamma_max] (dimensionless).
+    h: (N,) height offsets >= 0 [length, units of R], asperity k in lattice cell (k // n, k % n).
+    settings: the cell they live in. extras: any other keys of a design file, kept as they are.
+    """
+
+    gamma: np.ndarray
+    h: np.ndarray
+    settings: CellSettings = field(default_factory=CellSettings)
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        gamma = _as_vector("gamma", self.gamma)
+        h = _as_vector("h", self.h)
+        if gamma.shape != h.shape:
+            raise MetainterfaceError(
+                f"gamma and h must have the same length, got {gamma.size} and {h.size}"
+            )
+        if self.settings.n_asperities != gamma.size:
+            object.__setattr__(self, "settings", self.settings.with_(n_asperities=int(gamma.size)))
+        s = self.settings
+        tol = 1e-9 * (s.gamma_max - s.gamma_min)
+        bad = np.flatnonzero((gamma < s.gamma_min - tol) | (gamma > s.gamma_max + tol))
+        if bad.size:
+            i = int(bad[0])
+            raise MetainterfaceError(
+                f"gamma[{i}] = {gamma[i]:g} is outside the bounds "
+                f"[{s.gamma_min:g}, {s.gamma_max:g}] (and gamma must be > 1)"
+            )
+        bad = np.flatnonzero(h < 0)
+        if bad.size:
+            i = int(bad[0])
+            raise MetainterfaceError(f"h[{i}] = {h[i]:g} is negative; heights must be >= 0")
+        object.__setattr__(self, "gamma", np.clip(gamma, s.gamma_min, s.gamma_max))
+        object.__setattr__(self, "h", h)
+
+    @property
+    def n_asperities(self) -> int:
+        return int(self.gamma.size)
+
+    def tensors(self, dtype: torch.dtype = torch.float64) -> tuple[torch.Tensor, torch.Tensor]:
+        """(gamma, h) as (1, N) tensors: a batch of one for the physics functions."""
+        return (
+            torch.as_tensor(self.gamma, dtype=dtype)[None],
+            torch.as_tensor(self.h, dtype=dtype)[None],
+        )
+
+
+def _as_vector(name: str, values: Any) -> np.ndarray:
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise MetainterfaceError(f"{name} must be a list of numbers") from None
+    if arr.ndim != 1 or arr.size == 0:
+        raise MetainterfaceError(f"{name} must be a non-empty 1-D list of numbers")
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        raise MetainterfaceError(f"{name}[{int(bad[0])}] is {arr[bad[0]]}; values must be finite")
+    return arr
+
+
+def validate_batch(gamma: torch.Tensor, h: torch.Tensor, settings: CellSettings) -> None:
+    """Check a (B, N) batch of designs against the settings; raise MetainterfaceError."""
+    if gamma.ndim != 2 or gamma.shape != h.shape:
+        raise MetainterfaceError(
+            f"gamma and h must both be (batch, N) arrays of one shape, "
+            f"got {tuple(gamma.shape)} and {tuple(h.shape)}"
+        )
+    if gamma.shape[1] != settings.n_asperities:
+        raise MetainterfaceError(
+            f"designs have {gamma.shape[1]} asperities, settings say n_asperities = "
+            f"{settings.n_asperities}"
+        )
+    if not (torch.isfinite(gamma).all() and torch.isfinite(h).all()):
+        raise MetainterfaceError("gamma and h must be finite (found NaN or inf)")
+    if (gamma <= 1).any():
+        raise MetainterfaceError("gamma must be > 1 (the cone limit) for every asperity")
+    if (h < 0).any():
+        raise MetainterfaceError("h must be >= 0 for every asperity")

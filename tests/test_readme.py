@@ -1,0 +1,22 @@
+"""The README's two commands are the ones CI and users run."""
+
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _readme_commands() -> list[str]:
+    text = (ROOT / "README.md").read_text()
+    blocks = text.split("```bash\n")[1:3]
+    return [b.split("\n```")[0].strip() for b in blocks]
+
+
+def test_ci_runs_the_readme_test_command():
+    _, test_cmd = _readme_commands()
+    assert "pytest" in test_cmd
+    assert test_cmd in (ROOT / ".ci" / "run").read_text()
+
+
+def test_readme_install_takes_the_cpu_constraints():
+    for cmd in _readme_commands():
+        assert "-c constraints-cpu.txt" in cmd
