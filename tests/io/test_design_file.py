@@ -1,0 +1,52 @@
+"""design-v1 files: round trip, defaults, extras kept, one-line errors naming the field."""
+
+import json
+
+import numpy as np
+import pytest
+
+from metainterface.errors import MetainterfaceError
+from metainterface.io import load_design, save_design
+
+
+def write(tmp_path, data, name="d.json"):
+    path = tmp_path / name
+    path.write_text(data if isinstance(data, str) else json.dumps(data))
+    return path
+
+
+def test_round_trip_keeps_extras_and_defaults(tmp_path):
+    src = write(tmp_path, {"gamma": [2.0] * 4, "h": [0, 0.001, 0.002, 0.003], "note": {"a": 1}})
+    d = load_design(src)
+    assert d.settings.n_asperities == 4 and d.settings.delta_max == 0.02
+    assert d.extras == {"note": {"a": 1}}
+    out = save_design(tmp_path / "out" / "d2.json", d)
+    again = load_design(out)
+    np.testing.assert_array_equal(again.h, d.h)
+    data = json.loads(out.read_text())
+    assert data["format"] == "metainterface/design-v1" and data["note"] == {"a": 1}
+    assert "version" in data["provenance"]
+    assert not list(out.parent.glob(".*tmp"))  # no temporary left behind
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        ("{not json", "malformed JSON at line 1"),
+        ([1, 2], "JSON object"),
+        ({"h": [0.0]}, "missing required field 'gamma'"),
+        ({"gamma": [2.0] * 9, "h": [0.0] * 8}, "same length"),
+        ({"gamma": [2.0] * 8, "h": [0.0] * 8}, "perfect square"),
+        ({"gamma": [2.0, 2.0, 2.0, 0.9], "h": [0.0] * 4}, r"gamma\[3\] = 0.9 is outside"),
+        ({"gamma": [2.0, 2.0, 2.0, 4.5], "h": [0.0] * 4}, r"bounds \[1.8, 4\]"),
+        ({"gamma": [2.0] * 4, "h": [0.0, -1e-3, 0, 0]}, r"h\[1\] = -0.001 is negative"),
+        ({"gamma": [2.0] * 4, "h": [0.0, "x", 0, 0]}, "list of numbers"),
+        ({"gamma": [2.0] * 4, "h": [0.0, 0, 0, float("nan")]}, r"h\[3\] is nan"),
+        ({"gamma": [2.0] * 4, "h": [0.0] * 4, "format": "other/v9"}, "unknown format"),
+        ({"gamma": [2.0] * 4, "h": [0.0] * 4, "gamma_bounds": [3, 2]}, "gamma_min < gamma_max"),
+        ({"gamma": [2.0] * 4, "h": [0.0] * 4, "delta_max": 0}, "delta_max must be > 0"),
+    ],
+)
+def test_bad_files(tmp_path, data, message):
+    with pytest.raises(MetainterfaceError, match=message):
+        load_design(write(tmp_path, data))

@@ -1,0 +1,169 @@
+"""Unit-cell curves: lattice geometry, superposition, stiffness, gradients, gridding."""
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+from metainterface.errors import MetainterfaceError
+from metainterface.physics import CellSettings, curve, interp, kappa, sweep
+
+F64 = torch.float64
+S = CellSettings()
+
+
+def random_designs(b, n=9, seed=0, dtype=F64, settings=S):
+    gen = torch.Generator().manual_seed(seed)
+    g = settings.gamma_min + (settings.gamma_max - settings.gamma_min) * torch.rand(
+        b, n, generator=gen, dtype=dtype
+    )
+    h = settings.delta_max * torch.rand(b, n, generator=gen, dtype=dtype)
+    return g, h
+
+
+def test_a_max_and_cell_side():
+    # a = (Delta_max / (kappa c))^(1/gamma) is largest at gamma_max = 4 for the defaults
+    a4 = (0.02 / (8 / 3 * 0.5)) ** 0.25
+    assert S.a_max == pytest.approx(a4, rel=1e-12)
+    assert S.cell_side == pytest.approx(4 * 3 * a4)
+    assert S.nominal_area == pytest.approx((12 * a4) ** 2)
+    assert CellSettings(n_asperities=16).cell_side == pytest.approx(16 * a4)
+
+
+def test_uniform_hertz_cell_matches_closed_form():
+    g = torch.full((1, 9), 2.0, dtype=F64)
+    h = torch.zeros(1, 9, dtype=F64)
+    sw = sweep(g, h, S)
+    d = sw.delta
+    np.testing.assert_allclose(sw.p_star[0], 9 * 4 / 3 * d**1.5 / S.nominal_area, rtol=1e-10)
+    np.testing.assert_allclose(sw.alpha[0], 9 * math.pi * d / S.nominal_area, rtol=1e-10)
+    # S* = dP*/dalpha = (9 * 2 a) / (9 * pi) with a = sqrt(delta): S* = 2 sqrt(delta) / pi
+    np.testing.assert_allclose(sw.stiffness[0], 2 * d.sqrt() / math.pi, rtol=1e-10, atol=1e-14)
+
+
+def test_heights_shift_engagement_and_are_anchored():
+    g = torch.tensor([[3.0, 3.0, 3.0, 3.0]], dtype=F64)
+    h = torch.tensor([[0.005, 0.005, 0.015, 0.009]], dtype=F64)  # anchored: min h -> 0
+    s4 = CellSettings(n_asperities=4)
+    sw = sweep(g, h, s4)
+    kc = float(kappa(torch.tensor(3.0, dtype=F64))) / 2  # c = 1/2 at R = 1
+    d = sw.delta[:, None] - (h - h.min())[0][None]
+    a = torch.clamp_min(d, 0) ** (1 / 3) * kc ** (-1 / 3)
+    np.testing.assert_allclose(sw.alpha[0], math.pi * (a**2).sum(-1) / s4.nominal_area, rtol=1e-10)
+
+
+def test_stiffness_matches_finite_differences_away_from_engagement():
+    g, h = random_designs(4)
+    sw = sweep(g, h, S, n_delta=4001)
+    dp = torch.gradient(sw.p_star, spacing=(sw.delta,), dim=-1)[0]
+    da = torch.gradient(sw.alpha, spacing=(sw.delta,), dim=-1)[0]
+    fd = dp / da
+    h0 = (h - h.min(-1, keepdim=True).values)[:, None, :]
+    near = ((sw.delta[None, :, None] - h0).abs() < 2e-4).any(-1)  # within a few samples
+    ok = ~near & (sw.delta[None] > 1e-3)
+    np.testing.assert_allclose(sw.stiffness[ok], fd[ok], rtol=2e-3)
+
+
+def test_stiffness_singularities_are_finite():
+    # blunt (gamma > 2) asperity engaging while others carry load: S* -> 0; all finite
+    g = torch.tensor([[2.0, 4.0, 1.8, 3.9]], dtype=F64)
+    h = torch.tensor([[0.0, 0.01, 0.004, 0.0]], dtype=F64)
+    s4 = CellSettings(n_asperities=4)
+    delta = torch.tensor([0.0, 0.01, 0.01 + 1e-12, 0.004, 0.004 + 1e-15, 0.02], dtype=F64)
+    sw = sweep(g, h, s4, delta=delta)
+    assert torch.isfinite(sw.stiffness).all()
+    assert float(sw.stiffness[0, 0]) == 0.0  # nothing carries load yet
+    assert float(sw.stiffness[0, 2]) < 1e-3 * float(sw.stiffness[0, 1] + 1e-30) + 1e-4
+    for smooth in (None, 1e3, 1e5):
+        assert torch.isfinite(sweep(g, h, s4, smooth=smooth, n_delta=257).stiffness).all()
+
+
+def test_permutation_invariance():
+    g, h = random_designs(3, seed=1)
+    perm = torch.randperm(9, generator=torch.Generator().manual_seed(2))
+    a, b = curve(g, h, S), curve(g[:, perm], h[:, perm], S)
+    np.testing.assert_allclose(a.alpha, b.alpha, rtol=1e-12)
+    np.testing.assert_allclose(a.stiffness, b.stiffness, rtol=1e-12, atol=1e-15)
+
+
+def test_gradcheck_float64():
+    g, h = random_designs(2, seed=3)
+    g.requires_grad_()
+    h.requires_grad_()
+    for smooth in (None, 1e3):
+
+        def f(gg, hh, smooth=smooth):
+            c = curve(gg, hh, CellSettings(n_steps=16), smooth=smooth)
+            return c.alpha, c.p_star_max, c.alpha_max
+
+        assert torch.autograd.gradcheck(f, (g, h), eps=1e-7, atol=1e-6, rtol=1e-4)
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+@pytest.mark.parametrize("smooth", [None, 1e3, 1e5])
+def test_gradients_finite_at_first_contact(dtype, smooth):
+    # heights exactly on the Delta grid: asperities exactly at first contact
+    grid = torch.linspace(0, S.delta_max, S.n_steps, dtype=dtype)
+    g = torch.tensor([[1.8, 2.0, 4.0, 3.0, 2.5, 4.0, 1.8, 2.2, 3.3]], dtype=dtype)
+    h = grid[[0, 0, 5, 17, 17, 40, 90, 127, 60]][None].clone()
+    g.requires_grad_()
+    h.requires_grad_()
+    c = curve(g, h, S, smooth=smooth)
+    loss = c.alpha_hat.sum() + c.stiffness_hat.sum() + c.p_star_max.log().sum()
+    loss.backward()
+    assert torch.isfinite(g.grad).all() and torch.isfinite(h.grad).all()
+    assert torch.isfinite(c.stiffness).all()
+
+
+def test_float32_matches_float64():
+    g, h = random_designs(8, seed=4)
+    c64 = curve(g, h, S)
+    c32 = curve(g.float(), h.float(), S)
+    np.testing.assert_allclose(c32.alpha_hat, c64.alpha_hat, atol=2e-5)
+    np.testing.assert_allclose(c32.p_star_max, c64.p_star_max, rtol=1e-5)
+
+
+def test_grid_and_normalised_forms():
+    g, h = random_designs(5, seed=5)
+    c = curve(g, h, S)
+    sw = sweep(g, h, S)
+    np.testing.assert_allclose(c.p_star_max, sw.p_star[:, -1])
+    np.testing.assert_allclose(c.alpha_max, sw.alpha[:, -1])
+    np.testing.assert_allclose(c.alpha_hat[:, -1], 1.0)
+    assert float(c.alpha_hat[:, 0].abs().max()) == 0.0
+    assert c.features().shape == (5, 2 * 128 + 2)
+    # gridded alpha is the sweep's alpha interpolated at the grid pressures
+    mid = c.p_star[:, 64:65]
+    np.testing.assert_allclose(interp(mid, sw.p_star, sw.alpha), c.alpha[:, 64:65], rtol=1e-12)
+    assert (c.alpha.diff(dim=-1) >= 0).all()
+
+
+def test_softplus_curve_converges_to_exact():
+    g, h = random_designs(4, seed=6)
+    exact = curve(g, h, S).alpha_hat
+    errs = [float((curve(g, h, S, smooth=k).alpha_hat - exact).abs().max()) for k in (1e3, 1e5)]
+    assert errs[1] < errs[0] and errs[1] < 0.02
+
+
+def test_interp_holds_ends_and_duplicate_knots():
+    xp = torch.tensor([[0.0, 0.0, 1.0, 2.0]], dtype=F64)
+    fp = torch.tensor([[5.0, 0.0, 1.0, 4.0]], dtype=F64)
+    xq = torch.tensor([[-1.0, 0.0, 0.5, 1.5, 3.0]], dtype=F64)
+    np.testing.assert_allclose(interp(xq, xp, fp), [[5.0, 5.0, 0.5, 2.5, 4.0]])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"n_asperities": 8}, "perfect square"),
+        ({"gamma_min": 1.0}, "gamma_min"),
+        ({"gamma_min": 3.0, "gamma_max": 2.0}, "gamma_min < gamma_max"),
+        ({"delta_max": -0.01}, "delta_max"),
+        ({"radius": float("nan")}, "radius"),
+        ({"n_steps": 1}, "n_steps"),
+    ],
+)
+def test_settings_validation(kwargs, field):
+    with pytest.raises(MetainterfaceError, match=field):
+        CellSettings(**kwargs)
