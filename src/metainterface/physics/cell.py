@@ -8,6 +8,7 @@ is L = 4 n a_max and A_nom = L^2. Lengths are in the unit of R (R = 1 in the cor
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
@@ -84,19 +85,19 @@ class CellSettings:
         """n, the lattice side: N = n * n."""
         return math.isqrt(self.n_asperities)
 
-    @property
+    @functools.cached_property
     def a_max(self) -> float:
         """Largest contact radius reachable in the admissible space [length]."""
         gammas = torch.linspace(self.gamma_min, self.gamma_max, _A_MAX_SCAN, dtype=torch.float64)
         delta = torch.full_like(gammas, self.delta_max)
         return float(contact_radius(gammas, delta, self.radius).max())
 
-    @property
+    @functools.cached_property
     def cell_side(self) -> float:
         """L = 4 n a_max [length]."""
         return 4.0 * self.n_side * self.a_max
 
-    @property
+    @functools.cached_property
     def nominal_area(self) -> float:
         """A_nom = L^2 [length^2]."""
         return self.cell_side**2
@@ -113,6 +114,9 @@ class CellSettings:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+    def __reduce__(self):  # pickle (process pools) without the cached geometry
+        return (CellSettings, tuple(self.to_dict().values()))
 
     def with_(self, **changes: Any) -> CellSettings:
         """A copy with some fields changed (validated again)."""
