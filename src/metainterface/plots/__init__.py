@@ -2,5 +2,6 @@
 
 from metainterface.plots.common import new_figure, save_figure
 from metainterface.plots.curve import plot_curve
+from metainterface.plots.dataset import plot_dataset_examples
 
-__all__ = ["new_figure", "plot_curve", "save_figure"]
+__all__ = ["new_figure", "plot_curve", "plot_dataset_examples", "save_figure"]

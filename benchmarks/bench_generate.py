@@ -1,0 +1,55 @@
+"""Benchmark: generate 100,000 samples to disk; print wall seconds and peak memory.
+
+    python benchmarks/bench_generate.py [--samples 100000] [--seed 0] [--out DIR]
+
+Target (issue 3) on the 2-core dev machine: <= 3 s wall and <= 400 MB peak RSS. The wall
+time is that of ``generate_dataset`` (sampling, curves, writing, fsync); the import time of
+the package (torch, scipy) is printed separately. The peak RSS (ru_maxrss) covers the whole
+process, imports included.
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+t_import = time.perf_counter()
+from metainterface.data import generate_dataset  # noqa: E402
+from metainterface.physics import CellSettings  # noqa: E402
+
+t_import = time.perf_counter() - t_import
+
+
+def _peak_mb() -> float:
+    kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return kb / 1024 if sys.platform != "darwin" else kb / 2**20
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=100_000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", help="folder for the file (default: a temporary one)")
+    args = parser.parse_args()
+    settings = CellSettings()
+    with tempfile.TemporaryDirectory(dir=args.out) as tmp:
+        path = Path(tmp) / "bench.npz"
+        mb_before = _peak_mb()
+        t0 = time.perf_counter()
+        generate_dataset(args.samples, args.seed, settings, path, progress=False)
+        wall = time.perf_counter() - t0
+        size = path.stat().st_size / 2**20
+    print(f"import metainterface: {t_import:.2f} s, peak RSS after import {mb_before:.0f} MB")
+    print(
+        f"generate {args.samples} samples: {wall:.2f} s wall "
+        f"({args.samples / wall:,.0f} samples/s), file {size:.0f} MiB, "
+        f"peak RSS {_peak_mb():.0f} MB"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,483 @@
+"""The synthetic training dataset (paper sec. 2.4): generate it into one .npz, load it back.
+
+A dataset of S samples of an N-asperity cell holds, per sample, the design sorted by height
+(gamma moving with its h) and anchored so min h = 0, and its exact alpha(P*) curve in the
+normalised form of appendix A.1. Arrays of the file:
+
+    gamma (S, N) float64, h (S, N) float64 [units of R], category (S,) str, split (S,) str
+    in {train, val, test}, p_star_max (S,) float32 and alpha_max (S,) float32 (P* and alpha at
+    Delta = Delta_max), alpha_hat (S, n_steps) float32 and stiffness_hat (S, n_steps) float32
+    on the uniform grid P / P*_max in [0, 1], and meta: JSON text (format, every setting, seed,
+    package version; see ``generate_dataset``).
+
+Reproducibility: category c's samples come in blocks of at most ``block`` rows; block b is
+drawn by a generator seeded with ``SeedSequence(seed, spawn_key=(c, b))`` (the split with
+spawn key (6,)). The blocks depend only on (samples, block), not on the processing chunk, so
+a seed gives the same arrays whatever ``chunk`` is. Memory stays flat in S: each chunk is
+sampled, computed and written straight to its place in the file (``NpzStreamWriter``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import asdict, dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from metainterface.data.categories import CATEGORIES, CATEGORY_NAMES
+from metainterface.data.categories import category as find_category
+from metainterface.data.npz import NpzStreamWriter
+from metainterface.errors import MetainterfaceError
+from metainterface.io.atomic import atomic_open, ensure_parent
+from metainterface.io.provenance import provenance
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.curves import curves_numpy
+
+FORMAT = "metainterface/dataset-v1"
+SPLITS: tuple[str, ...] = ("train", "val", "test")
+SPLIT_FRACTIONS: tuple[float, ...] = (0.8, 0.1, 0.1)  # implemented by split_counts
+ARRAYS: tuple[str, ...] = (
+    "gamma",
+    "h",
+    "category",
+    "split",
+    "p_star_max",
+    "alpha_max",
+    "alpha_hat",
+    "stiffness_hat",
+    "meta",
+)
+DEFAULT_CHUNK = 8192  # samples sampled, computed and written together
+DEFAULT_BLOCK = 65536  # largest block one generator draws (fixes the LHS partition)
+_CURVE_ARRAYS = ("p_star_max", "alpha_max", "alpha_hat", "stiffness_hat")
+
+
+def allocate(total: int, fractions: Sequence[float]) -> np.ndarray:
+    """Integer counts that sum to ``total``, proportional to ``fractions`` (largest remainder).
+
+    Ties in the remainders go to the earlier entry. Returns an int64 array like ``fractions``.
+    """
+    w = np.asarray(fractions, dtype=np.float64)
+    raw = np.round(total * w / w.sum(), 9)
+    counts = np.floor(raw).astype(np.int64)
+    order = np.argsort(-(raw - counts), kind="stable")
+    counts[order[: total - int(counts.sum())]] += 1
+    return counts
+
+
+def sort_and_anchor(gamma: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sort each (S, N) design by height, gamma moving with its h, and shift so min h = 0."""
+    order = np.argsort(h, axis=1, kind="stable")
+    h = np.take_along_axis(h, order, axis=1)
+    gamma = np.take_along_axis(gamma, order, axis=1)
+    return gamma, h - h[:, :1]
+
+
+@dataclass(frozen=True)
+class GenerationReport:
+    """What ``generate_dataset`` wrote.
+
+    counts: samples per category; split_counts: samples per split; seconds: wall time;
+    examples: per category, up to a few test-split rows (gamma, h, p_star_max, alpha_max,
+    alpha_hat, stiffness_hat) for figures.
+    """
+
+    path: Path
+    samples: int
+    seed: int
+    settings: CellSettings
+    counts: dict[str, int]
+    split_counts: dict[str, int]
+    seconds: float
+    examples: dict[str, dict[str, np.ndarray]] = field(repr=False)
+
+
+def _whole(name: str, value: Any, low: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        raise MetainterfaceError(f"{name} must be a whole number >= {low}, got {value!r}")
+    return int(value)
+
+
+def _category_params(params: Mapping[str, Any] | None) -> list[Any]:
+    params = dict(params or {})
+    for name in params:
+        find_category(name)  # unknown names raise
+    out = []
+    for c in CATEGORIES:
+        p = params.get(c.name, c.params)
+        if type(p) is not type(c.params):
+            raise MetainterfaceError(
+                f"params for category {c.name!r} must be a {type(c.params).__name__}, "
+                f"got {type(p).__name__}"
+            )
+        out.append(p)
+    return out
+
+
+def _plan(counts: np.ndarray, block: int) -> list[tuple[int, int, int]]:
+    """(category index, block index, rows) of every block, in file order."""
+    plan = []
+    for c, n in enumerate(int(x) for x in counts):
+        n_blocks = -(-n // block)
+        for b, rows in enumerate(allocate(n, [1.0] * n_blocks) if n_blocks else []):
+            plan.append((c, b, int(rows)))
+    return plan
+
+
+def split_counts(counts: Sequence[int]) -> np.ndarray:
+    """(categories, 3) train/val/test counts: 80/10/10 overall and within every category.
+
+    Overall: val = round(S / 10) (halves up), test = floor(S / 10), train the rest. Each
+    category gets the val and test samples whose running index (categories in file order)
+    falls in it, so its own shares are within one sample of 10 % and never negative.
+    """
+    ends = np.cumsum(np.asarray(counts, dtype=np.int64))
+    starts = ends - np.asarray(counts, dtype=np.int64)
+
+    def val(t: np.ndarray) -> np.ndarray:
+        return (t + 5) // 10
+
+    def test(t: np.ndarray) -> np.ndarray:
+        return t // 10
+
+    n_val, n_test = val(ends) - val(starts), test(ends) - test(starts)
+    return np.stack([ends - starts - n_val - n_test, n_val, n_test], axis=1)
+
+
+def _split_labels(counts: np.ndarray, seed: int) -> np.ndarray:
+    """(S,) uint8 split index per sample (see ``split_counts``), shuffled in each category."""
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(len(CATEGORIES),)))
+    parts = [
+        rng.permutation(np.repeat(np.arange(len(SPLITS), dtype=np.uint8), per_split))
+        for per_split in split_counts(counts)
+    ]
+    return np.concatenate(parts) if parts else np.empty(0, np.uint8)
+
+
+def _designs(
+    plan: list[tuple[int, int, int]], seed: int, settings: CellSettings, params: list[Any]
+) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """(category index (k,), gamma (k, N), h (k, N)) block by block, in file order."""
+    n = settings.n_asperities
+    for c, b, rows in plan:
+        rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(c, b)))
+        gamma, h = CATEGORIES[c].sampler(rng, rows, settings, params[c])
+        if gamma.shape != (rows, n) or h.shape != (rows, n):  # pragma: no cover - sampler bug
+            raise RuntimeError(f"sampler {CATEGORIES[c].name} returned a wrong shape")
+        yield np.full(rows, c, dtype=np.uint8), gamma, h
+
+
+def _rechunk(
+    blocks: Iterator[tuple[np.ndarray, ...]], chunk: int
+) -> Iterator[tuple[np.ndarray, ...]]:
+    """Regroup a stream of row blocks into chunks of exactly ``chunk`` rows (the last: fewer)."""
+    pending: list[tuple[np.ndarray, ...]] = []
+    have = 0
+
+    def take(k: int) -> tuple[np.ndarray, ...]:
+        nonlocal have
+        parts = []
+        while k:
+            first = pending[0]
+            if len(first[0]) <= k:
+                parts.append(pending.pop(0))
+                k -= len(first[0])
+            else:
+                parts.append(tuple(a[:k] for a in first))
+                pending[0] = tuple(a[k:] for a in first)
+                k = 0
+        have -= sum(len(p[0]) for p in parts)
+        if len(parts) == 1:
+            return parts[0]
+        return tuple(np.concatenate(arrays) for arrays in zip(*parts, strict=True))
+
+    for blk in blocks:
+        pending.append(blk)
+        have += len(blk[0])
+        while have >= chunk:
+            yield take(chunk)
+    if have:
+        yield take(have)
+
+
+def _keep_examples(
+    kept: dict[int, list[dict[str, np.ndarray]]],
+    wanted: int,
+    cat: np.ndarray,
+    eligible: np.ndarray,
+    arrays: Mapping[str, np.ndarray],
+) -> None:
+    """Add to ``kept`` the first eligible rows of each category until it has ``wanted``."""
+    for c in np.unique(cat):
+        have = sum(len(r["h"]) for r in kept[int(c)])
+        rows = np.flatnonzero((cat == c) & eligible)[: max(0, wanted - have)]
+        if rows.size:
+            kept[int(c)].append({key: value[rows] for key, value in arrays.items()})
+
+
+def generate_dataset(
+    samples: int,
+    seed: int,
+    settings: CellSettings,
+    out: str | os.PathLike[str],
+    progress: bool = True,
+    chunk: int = DEFAULT_CHUNK,
+    *,
+    block: int = DEFAULT_BLOCK,
+    params: Mapping[str, Any] | None = None,
+    examples: int = 3,
+) -> GenerationReport:
+    """Generate ``samples`` designs of the six categories with their exact curves into ``out``.
+
+    samples: S > 0, split over the categories 20/16/16/16/16/16 % (largest remainder).
+    seed: integer >= 0; the same (samples, seed, settings, block, params) give the same arrays.
+    settings: the cell (N, R, E*, Delta_max, gamma bounds, n_steps of the curves).
+    out: the .npz path, written atomically (nothing under that name unless complete).
+    progress: show a tqdm bar (on stderr) once a run has taken more than 2 s.
+    chunk: samples processed together (about 1.2 kB each, on top of the fixed working memory
+        of ``curves_numpy``); results do not depend on it.
+    block: largest block of one category drawn by one generator (results depend on it;
+        recorded in meta). Each LHS block is one Latin hypercube.
+    params: category name -> parameter object (e.g. ``{"truncated": TruncatedParams(...)}``)
+        replacing that category's defaults.
+    examples: test-split rows per category kept in the report for figures.
+    Curves use the exact Macaulay bracket, computed in float32 by ``curves_numpy``.
+    """
+    if not isinstance(settings, CellSettings):
+        raise MetainterfaceError(f"settings must be a CellSettings, got {type(settings).__name__}")
+    samples = _whole("samples", samples, 1)
+    seed = _whole("seed", seed, 0)
+    chunk = _whole("chunk", chunk, 1)
+    block = _whole("block", block, 1)
+    examples = _whole("examples", examples, 0)
+    cat_params = _category_params(params)
+    started = time.perf_counter()
+
+    counts = allocate(samples, [c.fraction for c in CATEGORIES])
+    labels = _split_labels(counts, seed)
+    per_split = np.bincount(labels, minlength=len(SPLITS))
+    meta = provenance(
+        format=FORMAT,
+        samples=samples,
+        seed=seed,
+        cell=settings.to_dict(),
+        block=block,
+        curves={"bracket": "exact", "dtype": "float32", "n_steps": settings.n_steps},
+        categories={
+            c.name: {"fraction": c.fraction, "count": int(n), "params": asdict(p)}
+            for c, n, p in zip(CATEGORIES, counts, cat_params, strict=True)
+        },
+        splits={
+            "fractions": dict(zip(SPLITS, SPLIT_FRACTIONS, strict=True)),
+            "counts": {s: int(n) for s, n in zip(SPLITS, per_split, strict=True)},
+            "stratified_by": "category",
+        },
+    )
+    meta_text = json.dumps(meta, sort_keys=True)
+    n, steps = settings.n_asperities, settings.n_steps
+    cat_dtype = f"<U{max(len(s) for s in CATEGORY_NAMES)}"
+    split_dtype = f"<U{max(len(s) for s in SPLITS)}"
+    specs = {
+        "gamma": ((samples, n), np.float64),
+        "h": ((samples, n), np.float64),
+        "category": ((samples,), cat_dtype),
+        "split": ((samples,), split_dtype),
+        "p_star_max": ((samples,), np.float32),
+        "alpha_max": ((samples,), np.float32),
+        "alpha_hat": ((samples, steps), np.float32),
+        "stiffness_hat": ((samples, steps), np.float32),
+        "meta": ((), f"<U{len(meta_text)}"),
+    }
+    cat_names = np.array(CATEGORY_NAMES, dtype=cat_dtype)
+    split_names = np.array(SPLITS, dtype=split_dtype)
+    kept: dict[int, list[dict[str, np.ndarray]]] = {c: [] for c in range(len(CATEGORIES))}
+
+    from tqdm import tqdm
+
+    path = Path(out)
+    try:
+        ensure_parent(path)  # fail before any work on a path that cannot be written
+    except MetainterfaceError as exc:
+        raise MetainterfaceError(f"cannot write {path}: {exc}") from None
+    try:
+        with (
+            atomic_open(path, "wb") as fh,
+            tqdm(
+                total=samples,
+                unit="sample",
+                unit_scale=True,
+                desc="generate",
+                delay=2.0,
+                disable=not progress,
+            ) as bar,
+        ):
+            writer = NpzStreamWriter(fh, specs)
+            writer.write("meta", np.array(meta_text, dtype=specs["meta"][1]))
+            pos = 0
+            blocks = _designs(_plan(counts, block), seed, settings, cat_params)
+            for cat, gamma, h in _rechunk(blocks, chunk):
+                k = len(cat)
+                gamma, h = sort_and_anchor(gamma, h)
+                curves = curves_numpy(gamma, h, settings)
+                split = labels[pos : pos + k]
+                writer.write("gamma", gamma)
+                writer.write("h", h)
+                writer.write("category", cat_names[cat])
+                writer.write("split", split_names[split])
+                for name in _CURVE_ARRAYS:
+                    writer.write(name, curves[name])
+                if examples:
+                    curves.update(gamma=gamma, h=h)
+                    _keep_examples(kept, examples, cat, split == SPLITS.index("test"), curves)
+                pos += k
+                bar.update(k)
+            writer.close()
+    except OSError as exc:
+        raise MetainterfaceError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+    example_arrays = {
+        CATEGORIES[c].name: {key: np.concatenate([r[key] for r in rows]) for key in rows[0]}
+        for c, rows in kept.items()
+        if rows
+    }
+    return GenerationReport(
+        path=path,
+        samples=samples,
+        seed=seed,
+        settings=settings,
+        counts={c.name: int(x) for c, x in zip(CATEGORIES, counts, strict=True)},
+        split_counts={s: int(x) for s, x in zip(SPLITS, per_split, strict=True)},
+        seconds=time.perf_counter() - started,
+        examples=example_arrays,
+    )
+
+
+# -- loading --------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """A loaded dataset: the arrays of the file (see the module docstring), its settings, meta.
+
+    S samples; gamma, h (S, N); category, split (S,) str; p_star_max, alpha_max (S,);
+    alpha_hat, stiffness_hat (S, n_steps). ``subset`` selects rows by split and/or category.
+    """
+
+    gamma: np.ndarray
+    h: np.ndarray
+    category: np.ndarray
+    split: np.ndarray
+    p_star_max: np.ndarray
+    alpha_max: np.ndarray
+    alpha_hat: np.ndarray
+    stiffness_hat: np.ndarray
+    settings: CellSettings
+    meta: dict[str, Any] = field(repr=False)
+    path: Path | None = None
+
+    def __len__(self) -> int:
+        return int(self.gamma.shape[0])
+
+    @property
+    def seed(self) -> int:
+        return int(self.meta["settings"]["seed"])
+
+    def subset(self, split: str | None = None, *, category: str | None = None) -> Dataset:
+        """The rows of one split ('train', 'val' or 'test') and/or one category, in file order."""
+        keep = np.ones(len(self), dtype=bool)
+        if split is not None:
+            if split not in SPLITS:
+                raise MetainterfaceError(
+                    f"unknown split {split!r}, expected one of {', '.join(SPLITS)}"
+                )
+            keep &= self.split == split
+        if category is not None:
+            keep &= self.category == find_category(category).name
+        return replace(self, **{name: getattr(self, name)[keep] for name in _ROW_ARRAYS})
+
+
+_ROW_ARRAYS = tuple(name for name in ARRAYS if name != "meta")
+
+
+def load_dataset(path: str | os.PathLike[str], settings: CellSettings | None = None) -> Dataset:
+    """Read and check a dataset file; with ``settings``, the file's cell must equal them.
+
+    Raises a one-line MetainterfaceError naming the file and what is missing, malformed or
+    different (each differing setting with both values).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise MetainterfaceError(f"{path}: file not found")
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            missing = [name for name in ARRAYS if name not in npz.files]
+            if missing:
+                raise MetainterfaceError(
+                    f"{path}: missing array(s) {', '.join(missing)} "
+                    f"(a dataset holds {', '.join(ARRAYS)})"
+                )
+            arrays = {name: npz[name] for name in ARRAYS}
+    except MetainterfaceError:
+        raise
+    except Exception as exc:  # zipfile.BadZipFile, ValueError, OSError, ...
+        raise MetainterfaceError(f"{path}: not a readable .npz dataset ({exc})") from None
+
+    try:
+        meta = json.loads(str(arrays.pop("meta")[()]))
+        recorded = meta["settings"]
+        cell = recorded["cell"]
+    except (json.JSONDecodeError, KeyError, TypeError, IndexError):
+        raise MetainterfaceError(
+            f"{path}: meta is not a dataset record (no cell settings)"
+        ) from None
+    if recorded.get("format") != FORMAT:
+        raise MetainterfaceError(
+            f"{path}: meta format is {recorded.get('format')!r}, expected {FORMAT!r}"
+        )
+    try:
+        file_settings = CellSettings(**cell)
+    except (MetainterfaceError, TypeError) as exc:
+        raise MetainterfaceError(f"{path}: meta has invalid cell settings: {exc}") from None
+
+    s = arrays["gamma"].shape[0] if arrays["gamma"].ndim else -1
+    n, steps = file_settings.n_asperities, file_settings.n_steps
+    expected = {
+        "gamma": (s, n),
+        "h": (s, n),
+        "category": (s,),
+        "split": (s,),
+        "p_star_max": (s,),
+        "alpha_max": (s,),
+        "alpha_hat": (s, steps),
+        "stiffness_hat": (s, steps),
+    }
+    for name, shape in expected.items():
+        if arrays[name].shape != shape:
+            raise MetainterfaceError(
+                f"{path}: array {name} has shape {arrays[name].shape}, expected {shape} "
+                f"(N = {n}, n_steps = {steps})"
+            )
+    for name, allowed in (("category", CATEGORY_NAMES), ("split", SPLITS)):
+        bad = np.setdiff1d(np.unique(arrays[name]), allowed)
+        if bad.size:
+            raise MetainterfaceError(
+                f"{path}: array {name} holds unknown value {str(bad[0])!r}, "
+                f"expected {', '.join(allowed)}"
+            )
+
+    if settings is not None:
+        diffs = [
+            f"{f.name} is {getattr(file_settings, f.name)!r} in the file, expected "
+            f"{getattr(settings, f.name)!r}"
+            for f in fields(CellSettings)
+            if getattr(file_settings, f.name) != getattr(settings, f.name)
+        ]
+        if diffs:
+            raise MetainterfaceError(f"{path}: settings differ: {'; '.join(diffs)}")
+
+    return Dataset(**arrays, settings=file_settings, meta=meta, path=path)
