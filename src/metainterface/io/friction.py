@@ -1,0 +1,324 @@
+"""Friction-law targets: a measured or wished friction curve -> the dimensionless alpha(P*).
+
+Bowden and Tabor: the static friction force is the interface shear strength times the real
+contact area, F_f = tau A_real (paper sec. 2.3). For an interface of nominal area A (the
+whole tiled surface) and equivalent modulus E*:
+
+    alpha = A_real / A = F_f / (tau A),      P* = F_n / (A E*).
+
+The curve comes from a CSV with a header and one row per load, in newtons:
+``normal_force,friction_force`` or ``normal_force,friction_coefficient`` (F_f = mu F_n).
+With tau > 0, A_real and so F_f can only grow with the load: a friction force that decreases
+as the load increases, friction at zero load (adhesion is not modelled) or a real area larger
+than the nominal one is an error naming the row.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from metainterface.errors import MetainterfaceError
+from metainterface.io.csvfiles import read_columns
+from metainterface.physics.cell import CellSettings
+
+FORCE_COLUMNS = ("normal_force", "friction_force")
+COEFFICIENT_COLUMNS = ("normal_force", "friction_coefficient")
+#: Points a target needs (the design command's minimum), the added origin included.
+MIN_POINTS = 3
+
+
+@dataclass(frozen=True)
+class FrictionLaw:
+    """A friction curve in newtons, rows in strictly increasing normal force.
+
+    normal_force, friction_force: (K,) [N]. rows: (K,) 1-based data rows of the source file
+    (0 marks the origin added by :func:`friction_target`). source: file name for messages.
+    """
+
+    normal_force: np.ndarray
+    friction_force: np.ndarray
+    rows: np.ndarray
+    source: str = "friction law"
+
+
+def _header(path: Path) -> list[str]:
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError:
+        raise MetainterfaceError(f"{path}: file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MetainterfaceError(f"{path}: cannot read ({exc})") from None
+    for line in lines:
+        if line.strip() and not line.lstrip().startswith("#"):
+            return [c.strip() for c in line.split(",")]
+    return []
+
+
+def read_friction_csv(path: str | os.PathLike[str]) -> FrictionLaw:
+    """Read a friction curve: ``normal_force,friction_force`` or ``...,friction_coefficient``.
+
+    Forces in newtons, the coefficient dimensionless. Checks every row (finite, >= 0, normal
+    force strictly increasing, friction never decreasing, no friction at zero load).
+    """
+    path = Path(path)
+    header = _header(path)
+    if "friction_force" in header:
+        cols = read_columns(path, FORCE_COLUMNS)
+        friction = cols["friction_force"]
+    elif "friction_coefficient" in header:
+        cols = read_columns(path, COEFFICIENT_COLUMNS)
+        _check_values(path, "friction_coefficient", cols["friction_coefficient"])
+        friction = cols["friction_coefficient"] * cols["normal_force"]
+    else:
+        raise MetainterfaceError(
+            f"{path}: the header must be normal_force,friction_force (N) or "
+            f"normal_force,friction_coefficient (found {','.join(header) or 'nothing'})"
+        )
+    law = FrictionLaw(
+        normal_force=cols["normal_force"],
+        friction_force=friction,
+        rows=np.arange(1, friction.size + 1),
+        source=str(path),
+    )
+    check_law(law)
+    return law
+
+
+def _check_values(source: Any, name: str, values: np.ndarray) -> None:
+    for i, v in enumerate(values, start=1):
+        if not math.isfinite(v) or v < 0:
+            raise MetainterfaceError(f"{source}: row {i}: {name} = {v:g}; must be finite and >= 0")
+
+
+def check_law(law: FrictionLaw) -> None:
+    """Raise MetainterfaceError, naming the row, if the curve is impossible with tau > 0."""
+    fn, ff, rows, src = law.normal_force, law.friction_force, law.rows, law.source
+    if fn.size < 2:
+        raise MetainterfaceError(f"{src}: need at least 2 rows, got {fn.size}")
+    _check_values(src, "normal_force", fn)
+    _check_values(src, "friction_force", ff)
+    for k in range(fn.size):
+        if fn[k] == 0 and ff[k] > 0:
+            raise MetainterfaceError(
+                f"{src}: row {rows[k]}: friction {ff[k]:g} N at zero normal force; with "
+                f"F_f = tau A_real (no adhesion) friction vanishes with the load"
+            )
+        if k == 0:
+            continue
+        if fn[k] <= fn[k - 1]:
+            raise MetainterfaceError(
+                f"{src}: row {rows[k]}: normal_force {fn[k]:g} N is not above row "
+                f"{rows[k - 1]}'s {fn[k - 1]:g} N; rows must be in strictly increasing load"
+            )
+        if ff[k] < ff[k - 1] * (1 - 1e-12):
+            raise MetainterfaceError(
+                f"{src}: row {rows[k]}: friction {ff[k]:g} N at {fn[k]:g} N is below "
+                f"{ff[k - 1]:g} N at the lower load {fn[k - 1]:g} N (row {rows[k - 1]}); with a "
+                f"positive shear strength F_f = tau A_real cannot decrease as the load grows"
+            )
+
+
+def friction_to_alpha(
+    normal_force: np.ndarray,
+    friction_force: np.ndarray,
+    *,
+    shear_strength: float,
+    e_star: float,
+    area: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(P*, alpha) from loads and friction forces (K,) [N]: P* = F_n/(A E*), alpha = F_f/(tau A).
+
+    shear_strength tau [Pa], e_star E* [Pa], area A: nominal area of the whole interface [m^2].
+    """
+    fn = np.asarray(normal_force, dtype=np.float64)
+    ff = np.asarray(friction_force, dtype=np.float64)
+    return fn / (area * e_star), ff / (shear_strength * area)
+
+
+def alpha_to_friction(
+    p_star: np.ndarray,
+    alpha: np.ndarray,
+    *,
+    shear_strength: float,
+    e_star: float,
+    area: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(F_n, F_f) [N] from a dimensionless curve (K,): the inverse of :func:`friction_to_alpha`."""
+    p = np.asarray(p_star, dtype=np.float64)
+    a = np.asarray(alpha, dtype=np.float64)
+    return p * area * e_star, a * shear_strength * area
+
+
+def friction_columns(
+    p_star: np.ndarray,
+    alpha: np.ndarray,
+    *,
+    shear_strength: float,
+    e_star: float,
+    area: float,
+) -> dict[str, np.ndarray]:
+    """Report columns normal_force, friction_force [N] and friction_coefficient (NaN at 0 load)."""
+    fn, ff = alpha_to_friction(
+        p_star, alpha, shear_strength=shear_strength, e_star=e_star, area=area
+    )
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mu = np.where(fn > 0, ff / np.where(fn > 0, fn, 1.0), np.nan)
+    return {"normal_force": fn, "friction_force": ff, "friction_coefficient": mu}
+
+
+@dataclass(frozen=True)
+class FrictionTarget:
+    """A friction law turned into the dimensionless target of the design step.
+
+    p_star, alpha: (K,) the target curve, P* strictly increasing from 0. law: the curve in
+    newtons (with the origin if it was added). shear_strength tau [Pa], e_star E* [Pa],
+    radius R [m], area: nominal area of the whole interface [m^2]. n_cells: area / (L R)^2,
+    unit cells that tile it (L from ``settings``).
+    """
+
+    p_star: np.ndarray
+    alpha: np.ndarray
+    law: FrictionLaw
+    shear_strength: float
+    e_star: float
+    radius: float
+    area: float
+    n_cells: float
+    settings: CellSettings = field(default_factory=CellSettings)
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """{'p_star', 'alpha'}: the target as the design command's CSV columns."""
+        return {"p_star": self.p_star, "alpha": self.alpha}
+
+    def record(self) -> dict[str, Any]:
+        """JSON-ready description in SI, for design.json and provenance."""
+        return {
+            "source": self.law.source,
+            "shear_strength_pa": self.shear_strength,
+            "e_star_pa": self.e_star,
+            "radius_m": self.radius,
+            "area_m2": self.area,
+            "n_cells": self.n_cells,
+            "normal_force_n": [float(v) for v in self.law.normal_force],
+            "friction_force_n": [float(v) for v in self.law.friction_force],
+        }
+
+
+def friction_target(
+    law: FrictionLaw | str | os.PathLike[str],
+    *,
+    shear_strength: float,
+    e_star: float,
+    radius: float,
+    area: float,
+    settings: CellSettings | None = None,
+    include_origin: bool = True,
+) -> FrictionTarget:
+    """Convert a friction law (a FrictionLaw or a CSV path) into the alpha(P*) target.
+
+    shear_strength tau [Pa], e_star E* [Pa], radius R [m], area: nominal area of the whole
+    interface [m^2], all > 0 (parse them with ``metainterface.io.units``). settings: the cell
+    (default: the paper's), used for L. include_origin: prepend (0 N, 0 N) when the first load
+    is > 0 (F_f = tau A_real vanishes with the load). Errors name the row.
+    """
+    settings = settings or CellSettings()
+    for name, value in (
+        ("shear strength", shear_strength),
+        ("modulus E*", e_star),
+        ("radius", radius),
+        ("area", area),
+    ):
+        if not (math.isfinite(value) and value > 0):
+            raise MetainterfaceError(f"{name} must be finite and > 0, got {value!r}")
+    if not isinstance(law, FrictionLaw):
+        law = read_friction_csv(law)
+    else:
+        check_law(law)
+    if include_origin and law.normal_force[0] > 0:
+        law = FrictionLaw(
+            normal_force=np.concatenate([[0.0], law.normal_force]),
+            friction_force=np.concatenate([[0.0], law.friction_force]),
+            rows=np.concatenate([[0], law.rows]),
+            source=law.source,
+        )
+    if law.normal_force.size < MIN_POINTS:
+        raise MetainterfaceError(
+            f"{law.source}: a target needs at least {MIN_POINTS} points (origin included), "
+            f"got {law.normal_force.size}"
+        )
+    cell_area = (settings.cell_side / settings.radius * radius) ** 2
+    if area < cell_area:
+        raise MetainterfaceError(
+            f"area {area:g} m^2 is smaller than one unit cell (L R)^2 = {cell_area:g} m^2; "
+            f"give a larger --area or a smaller --radius"
+        )
+    p_star, alpha = friction_to_alpha(
+        law.normal_force,
+        law.friction_force,
+        shear_strength=shear_strength,
+        e_star=e_star,
+        area=area,
+    )
+    over = np.flatnonzero(alpha >= 1)
+    if over.size:
+        k = int(over[0])
+        raise MetainterfaceError(
+            f"{law.source}: row {law.rows[k]}: friction {law.friction_force[k]:g} N needs a real "
+            f"contact area F_f / tau = {law.friction_force[k] / shear_strength:g} m^2, not below "
+            f"the nominal area {area:g} m^2 (alpha = {alpha[k]:.3g}); check --shear-strength "
+            f"and --area"
+        )
+    return FrictionTarget(
+        p_star=p_star,
+        alpha=alpha,
+        law=law,
+        shear_strength=float(shear_strength),
+        e_star=float(e_star),
+        radius=float(radius),
+        area=float(area),
+        n_cells=area / cell_area,
+        settings=settings,
+    )
+
+
+def friction_target_from_options(
+    path: str | os.PathLike[str],
+    *,
+    shear_strength: str | None,
+    modulus: str | None,
+    radius: str | None,
+    area: str | None,
+    settings: CellSettings | None = None,
+) -> FrictionTarget:
+    """:func:`friction_target` from command-line strings with units ('0.25MPa', '4cm2').
+
+    Errors name the options --friction-csv, --shear-strength, --modulus, --radius, --area.
+    """
+    from metainterface.io.units import parse_area, parse_length, parse_pressure
+
+    given = {
+        "--shear-strength": shear_strength,
+        "--modulus": modulus,
+        "--radius": radius,
+        "--area": area,
+    }
+    missing = [name for name, value in given.items() if value is None]
+    if missing:
+        raise MetainterfaceError(
+            f"--friction-csv needs --shear-strength, --modulus, --radius and --area "
+            f"(missing {', '.join(missing)})"
+        )
+    return friction_target(
+        path,
+        shear_strength=parse_pressure(shear_strength, option="--shear-strength"),
+        e_star=parse_pressure(modulus, option="--modulus"),
+        radius=parse_length(radius, option="--radius"),
+        area=parse_area(area, option="--area"),
+        settings=settings,
+    )
