@@ -53,7 +53,7 @@ ARRAYS: tuple[str, ...] = (
     "meta",
 )
 DEFAULT_CHUNK = 8192  # samples sampled, computed and written together
-DEFAULT_BLOCK = 65536  # largest block one generator draws (fixes the LHS partition)
+DEFAULT_BLOCK = 32768  # largest block one generator draws (fixes the LHS partition)
 _CURVE_ARRAYS = ("p_star_max", "alpha_max", "alpha_hat", "stiffness_hat")
 
 
