@@ -15,8 +15,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "generate",
         help="synthetic dataset: six topography categories and their exact curves (.npz)",
-        description="Sample S designs of the paper's six categories (LHS 20 %%, truncated, "
-        "bimodal, stratified, coplanar, mixed 16 %% each), sort and anchor them, compute "
+        description="Sample S designs of the paper's six categories (LHS 20 %, truncated, "
+        "bimodal, stratified, coplanar, mixed 16 % each), sort and anchor them, compute "
         "their exact normalised alpha(P*) curves and write one .npz with an 80/10/10 "
         "train/val/test split. The same seed gives the same arrays.",
     )
