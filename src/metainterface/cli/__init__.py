@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from metainterface.errors import MetainterfaceError
 
 # Subcommand modules, in the order `--help` lists them.
-COMMANDS: tuple[str, ...] = ("curve", "generate", "export")
+COMMANDS: tuple[str, ...] = ("curve", "generate", "export", "validate")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,75 @@
+"""BEM validation of one design, like the paper's fig. 6: curves, topography, pressure."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from metainterface.plots.common import new_figure
+
+if TYPE_CHECKING:
+    from metainterface.validation.validate import ValidationResult
+
+
+def plot_validation(
+    result: ValidationResult,
+    *,
+    target: tuple[np.ndarray, np.ndarray] | None = None,
+    title: str | None = None,
+) -> Figure:
+    """Three panels: alpha(P*) (target, model, BEM), the cell's height map, p/E* at the
+    largest load. target: optional (p_star, alpha) arrays of the design's target curve."""
+    fig = new_figure(width=13.0, height=4.0)
+    ax_c, ax_h, ax_p = fig.subplots(1, 3)
+    p_top = float(result.p_star[-1])
+    keep = result.model.p_star <= p_top * (1 + 1e-12)
+    if target is not None:
+        ax_c.plot(target[0], target[1], color="k", lw=1.5, label="target")
+    ax_c.plot(
+        result.model.p_star[keep],
+        result.model.alpha[keep],
+        ls="--",
+        color="C0",
+        label=f"model ({result.physics})",
+    )
+    ax_c.plot(
+        result.p_star,
+        result.alpha_bem,
+        "o",
+        mfc="none",
+        color="C3",
+        label=f"BEM ({result.grid}$^2$)",
+    )
+    ax_c.set(xlabel=r"$P^* = P/E^*$", ylabel=r"$\alpha = A/A_{nom}$", title="contact area")
+    ax_c.set_xlim(left=0)
+    ax_c.set_ylim(bottom=0)
+    ax_c.grid(alpha=0.3)
+    ax_c.legend(fontsize=8, loc="lower right")
+    ax_c.text(
+        0.03,
+        0.97,
+        f"max |rel. err.| (upper half) = {100 * result.max_rel_err_upper:.2f} %",
+        transform=ax_c.transAxes,
+        va="top",
+        fontsize=8,
+    )
+
+    radius = result.design.settings.radius  # axes in units of R
+    side = result.heights.cell_side / radius
+    extent = (0.0, side, 0.0, side)
+    # Colours span the heights that can touch (a few Delta_max below the highest tip); the
+    # deep cell corners saturate.
+    z = result.heights.heights / radius
+    z_low = max(float(z.min()), -4.0 * result.design.settings.delta_max / radius)
+    im = ax_h.imshow(z, origin="lower", extent=extent, cmap="viridis", vmin=z_low, vmax=0.0)
+    ax_h.set(xlabel="x / R", ylabel="y / R", title="topography")
+    fig.colorbar(im, ax=ax_h, label="z / R", shrink=0.85, extend="min")
+
+    im = ax_p.imshow(result.pressure, origin="lower", extent=extent, cmap="magma")
+    ax_p.set(xlabel="x / R", ylabel="y / R", title=rf"$p/E^*$ at $P^* = {p_top:.3g}$")
+    fig.colorbar(im, ax=ax_p, label=r"$p/E^*$", shrink=0.85)
+    if title:
+        fig.suptitle(title, fontsize=9)
+    return fig

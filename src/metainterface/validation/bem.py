@@ -1,0 +1,305 @@
+"""Normal contact of a periodic cell with the boundary element method (Tamaas; paper sec. 4.1).
+
+A rigid periodic surface (the cell's height map, tips up) is pressed on an elastic half-space
+with E* = 1 (E = 1, nu = 0), so pressures are P* = P / E* and p / E*. The Polonsky-Keer-Rey
+solver (tolerance 1e-11) is driven by the mean pressure; a load path of ascending pressures
+starts each solve from the previous solution (Tamaas keeps the traction field between solves).
+
+Only numpy and Tamaas are used here, so the functions run in worker processes without torch.
+The Tamaas wheel is single-threaded and holds the GIL: parallelism is by processes
+(``solve_loads`` with ``jobs > 1`` splits a load path into contiguous chunks).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing as mp
+import os
+import sys
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from metainterface.errors import MetainterfaceError
+
+#: Convergence tolerance of the Polonsky-Keer-Rey solver (the paper's value).
+TOLERANCE = 1e-11
+#: Iteration cap per solve (Tamaas's default). 768^2 cells converge in ~110 iterations.
+MAX_ITER = 1000
+
+INSTALL_HINT = "pip install tamaas"
+
+
+def require_tamaas() -> ModuleType:
+    """Import Tamaas, or raise a one-line MetainterfaceError with the install command."""
+    try:
+        import tamaas
+    except ImportError:
+        raise MetainterfaceError(
+            f"BEM validation needs Tamaas, which is not installed: run `{INSTALL_HINT}`"
+        ) from None
+    return tamaas
+
+
+@dataclass(frozen=True)
+class LoadPath:
+    """BEM measurements along a load path of K mean pressures.
+
+    alpha: (K,) fraction of grid points in contact. p_max: (K,) largest local p / E*.
+    asperity_alpha: (K, N) contact area of each asperity / A_nom (grid points in contact in
+    the asperity's lattice cell over M^2). residual: (K,) the solver's final error.
+    seconds: (K,) wall time of each solve. pressure: (M, M) p / E* at the last load.
+    """
+
+    alpha: np.ndarray
+    p_max: np.ndarray
+    asperity_alpha: np.ndarray
+    residual: np.ndarray
+    seconds: np.ndarray
+    pressure: np.ndarray
+
+    @staticmethod
+    def concat(parts: list[LoadPath]) -> LoadPath:
+        """Join chunks of one path, in order; the pressure field is the last chunk's."""
+        return LoadPath(
+            alpha=np.concatenate([p.alpha for p in parts]),
+            p_max=np.concatenate([p.p_max for p in parts]),
+            asperity_alpha=np.concatenate([p.asperity_alpha for p in parts]),
+            residual=np.concatenate([p.residual for p in parts]),
+            seconds=np.concatenate([p.seconds for p in parts]),
+            pressure=parts[-1].pressure,
+        )
+
+
+@contextlib.contextmanager
+def _quiet(tm: ModuleType) -> Iterator[None]:
+    """Silence Tamaas's per-solve iteration log (printed at its default 'info' level)."""
+    level = tm.get_log_level()
+    tm.set_log_level(tm.LogLevel.error)
+    try:
+        yield
+    finally:
+        tm.set_log_level(level)
+
+
+def solve_path(
+    heights: np.ndarray,
+    cell_side: float,
+    loads: np.ndarray,
+    owner: np.ndarray,
+    n_asperities: int,
+    *,
+    tolerance: float = TOLERANCE,
+    max_iter: int = MAX_ITER,
+    first_index: int = 0,
+    total: int | None = None,
+    report: Callable[[int], Any] | None = None,
+) -> LoadPath:
+    """Solve the contact of one cell at ascending mean pressures ``loads`` (K,) [P* = P/E*].
+
+    heights: (M, M) surface [length], tips up; cell_side: L [same length]; owner: (M, M)
+    asperity index of each grid point. The first load starts from zero traction, each next
+    one from the previous solution. ``report(1)`` is called after each load. ``first_index``
+    and ``total`` only number the loads in error messages (for chunks of a longer path).
+    Raises MetainterfaceError naming the load and the residual if a solve does not converge.
+    """
+    tm = require_tamaas()
+    loads = np.asarray(loads, dtype=np.float64)
+    total = len(loads) if total is None else total
+    surface = np.ascontiguousarray(heights, dtype=np.float64)  # Tamaas keeps a reference
+    m = surface.shape[0]
+    k = len(loads)
+    alpha, p_max, residual, seconds = (np.empty(k) for _ in range(4))
+    per = np.empty((k, n_asperities))
+    owner_flat = np.asarray(owner).ravel()
+    with _quiet(tm):
+        model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [float(cell_side)] * 2, [m, m])
+        model.E, model.nu = 1.0, 0.0  # E* = E / (1 - nu^2) = 1
+        if abs(model.E_star - 1.0) > 1e-14:  # pragma: no cover - a Tamaas API change
+            raise MetainterfaceError(f"Tamaas model has E* = {model.E_star}, expected 1")
+        solver = tm.PolonskyKeerRey(model, surface, tolerance)
+        solver.max_iter = int(max_iter)
+        for i, p in enumerate(loads):
+            start = time.perf_counter()
+            try:
+                err = float(solver.solve(float(p)))
+            except (RuntimeError, ArithmeticError) as exc:  # Tamaas's own checks
+                raise MetainterfaceError(
+                    f"BEM failed at load {first_index + i + 1} of {total} (P* = {p:.6g}): "
+                    f"{str(exc).strip().splitlines()[-1]} (try a finer grid)"
+                ) from None
+            seconds[i] = time.perf_counter() - start
+            if not err <= tolerance:
+                raise MetainterfaceError(
+                    f"BEM did not converge at load {first_index + i + 1} of {total} "
+                    f"(P* = {p:.6g}): residual {err:.3g} > tolerance {tolerance:g} "
+                    f"after {max_iter} iterations"
+                )
+            traction = model.traction.reshape(m, m)
+            contact = (traction > 0).ravel()
+            counts = np.bincount(owner_flat[contact], minlength=n_asperities)
+            per[i] = counts / (m * m)
+            alpha[i] = counts.sum() / (m * m)
+            p_max[i] = float(traction.max())
+            residual[i] = err
+            if report is not None:
+                report(1)
+        pressure = np.array(model.traction.reshape(m, m), copy=True)
+    return LoadPath(alpha, p_max, per, residual, seconds, pressure)
+
+
+# --- processes ---------------------------------------------------------------------------
+
+_progress_queue: Any = None
+
+
+def _init_worker(queue: Any) -> None:
+    global _progress_queue
+    _progress_queue = queue
+
+
+def _report_to_queue(n: int) -> None:
+    if _progress_queue is not None:
+        _progress_queue.put(n)
+
+
+def _solve_task(kwargs: dict[str, Any]) -> LoadPath:
+    return solve_path(**kwargs, report=_report_to_queue)
+
+
+def _context() -> mp.context.BaseContext:
+    # fork: workers start in milliseconds and need no imports (they run numpy + Tamaas only,
+    # never torch). Where fork is unavailable or unsafe (macOS, Windows), spawn.
+    if sys.platform.startswith("linux"):
+        return mp.get_context("fork")
+    return mp.get_context("spawn")  # pragma: no cover
+
+
+def available_cpus() -> int:
+    """Cores this process may use."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+def run_tasks(
+    tasks: list[dict[str, Any]],
+    jobs: int,
+    *,
+    progress: Callable[[int], Any] | None = None,
+    on_done: Callable[[int, LoadPath], Any] | None = None,
+    on_error: Callable[[int, BaseException], Any] | None = None,
+) -> list[LoadPath | None]:
+    """Run ``solve_path(**task)`` for each task on up to ``jobs`` processes.
+
+    progress(n) is called in this process as loads finish; on_done(i, result) as each task
+    finishes. A failing task raises at once (other workers are stopped) unless ``on_error``
+    is given, which then receives it and the task's slot stays None.
+    """
+    results: list[LoadPath | None] = [None] * len(tasks)
+    if jobs <= 1 or len(tasks) <= 1:
+        for i, task in enumerate(tasks):
+            try:
+                results[i] = solve_path(**task, report=progress)
+            except MetainterfaceError as exc:
+                if on_error is None:
+                    raise
+                on_error(i, exc)
+                continue
+            if on_done is not None:
+                on_done(i, results[i])
+        return results
+    ctx = _context()
+    queue = ctx.Queue()
+    pool = ctx.Pool(min(jobs, len(tasks)), initializer=_init_worker, initargs=(queue,))
+    try:
+        pending = {i: pool.apply_async(_solve_task, (task,)) for i, task in enumerate(tasks)}
+        while pending:
+            for i, res in list(pending.items()):
+                if not res.ready():
+                    continue
+                del pending[i]
+                try:
+                    results[i] = res.get()
+                except MetainterfaceError as exc:
+                    if on_error is None:
+                        raise
+                    on_error(i, exc)
+                    continue
+                if on_done is not None:
+                    on_done(i, results[i])
+            _drain(queue, progress, block=bool(pending))
+        pool.close()
+        pool.join()
+    finally:
+        pool.terminate()
+        _drain(queue, progress, block=False)
+    return results
+
+
+def _drain(queue: Any, progress: Callable[[int], Any] | None, *, block: bool) -> None:
+    import queue as queue_mod
+
+    try:
+        n = queue.get(timeout=0.2) if block else queue.get_nowait()
+        while True:
+            if progress is not None:
+                progress(n)
+            n = queue.get_nowait()
+    except queue_mod.Empty:
+        pass
+
+
+def split_path(k: int, jobs: int, weights: np.ndarray | None = None) -> list[np.ndarray]:
+    """Split load indices 0..k-1 into at most ``jobs`` contiguous, non-empty chunks of about
+    equal total weight (equal sizes without weights)."""
+    jobs = max(1, min(jobs, k))
+    w = np.ones(k) if weights is None else np.asarray(weights, dtype=np.float64)
+    cum = np.concatenate([[0.0], np.cumsum(w) / w.sum()])  # weight before load i
+    # chunk j ends where the cumulative weight is nearest to (j + 1) / jobs
+    targets = np.arange(1, jobs) / jobs + 1e-9  # ties: the earlier (lighter) chunk grows
+    ends = np.abs(cum[None, :] - targets[:, None]).argmin(axis=1)
+    ends = np.maximum(ends, np.arange(1, jobs))  # at least one load per chunk ...
+    ends = np.minimum(ends, k - jobs + np.arange(1, jobs))  # ... leaving one for the rest
+    ends = np.maximum.accumulate(ends)
+    return [c for c in np.split(np.arange(k), ends) if c.size]
+
+
+def solve_loads(
+    heights: np.ndarray,
+    cell_side: float,
+    loads: np.ndarray,
+    owner: np.ndarray,
+    n_asperities: int,
+    *,
+    jobs: int = 1,
+    tolerance: float = TOLERANCE,
+    max_iter: int = MAX_ITER,
+    weights: np.ndarray | None = None,
+    progress: Callable[[int], Any] | None = None,
+) -> LoadPath:
+    """One cell's load path (K,), split into ``jobs`` contiguous warm-started chunks.
+
+    Each chunk starts from zero traction and then follows its own part of the path; the
+    solution is unique, so chunking changes results only within the tolerance. weights: (K,)
+    expected relative cost of each load, to balance the chunks (default: equal).
+    """
+    loads = np.asarray(loads, dtype=np.float64)
+    chunks = split_path(len(loads), jobs, weights)
+    common = dict(
+        heights=heights,
+        cell_side=cell_side,
+        owner=owner,
+        n_asperities=n_asperities,
+        tolerance=tolerance,
+        max_iter=max_iter,
+        total=len(loads),
+    )
+    tasks = [{**common, "loads": loads[c], "first_index": int(c[0])} for c in chunks]
+    parts = run_tasks(tasks, jobs, progress=progress)
+    return LoadPath.concat([p for p in parts if p is not None])

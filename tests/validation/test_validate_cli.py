@@ -1,0 +1,75 @@
+"""`metainterface validate`: output files and summary line; bad input is one line, exit 2."""
+
+import json
+import sys
+from importlib.resources import files
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from metainterface.cli import main
+
+EXAMPLE = str(files("metainterface") / "examples" / "example_design.json")
+
+
+def test_validate_writes_csv_figure_and_prints_the_error(tmp_path, capsys):
+    design = json.loads(Path(EXAMPLE).read_text())
+    design["target"] = {"p_star": [0.0, 0.001, 0.002], "alpha": [0.0, 0.04, 0.07]}
+    path = tmp_path / "d.json"
+    path.write_text(json.dumps(design))
+    out = tmp_path / "run"
+    args = ["validate", str(path), "--grid", "96", "--loads", "2", "--jobs", "1"]
+    assert main([*args, "--out", str(out)]) == 0
+    data = np.genfromtxt(out / "bem.csv", delimiter=",", names=True, skip_header=1)
+    assert data.dtype.names == ("p_star", "alpha_bem", "alpha_model", "rel_err", "p_max")
+    np.testing.assert_allclose(data["rel_err"], data["alpha_bem"] / data["alpha_model"] - 1)
+    assert (out / "bem.csv").read_text().startswith("# {")
+    assert (out / "validation.png").stat().st_size > 20_000
+    per = np.genfromtxt(out / "asperities.csv", delimiter=",", names=True, skip_header=1)
+    assert len(per.dtype.names) == 1 + 2 * 9
+    printed = capsys.readouterr().out
+    assert "largest relative error over the upper half of the loads" in printed
+
+
+def one_line_error(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--grid", "100"], "grid must be a multiple of the lattice side n = 3"),
+        (["--p-max", "1.0"], "beyond what the design reaches at Delta_max"),
+    ],
+)
+def test_bad_grid_or_load_is_one_line(tmp_path, capsys, extra, message):
+    out = tmp_path / "run"
+    assert main(["validate", EXAMPLE, *extra, "--jobs", "1", "--out", str(out)]) == 2
+    assert message in one_line_error(capsys)
+    assert not out.exists()
+
+
+def test_loads_must_be_positive(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["validate", EXAMPLE, "--loads", "0", "--out", str(tmp_path)])
+    assert exc.value.code == 2
+    assert "--loads: must be > 0" in capsys.readouterr().err
+
+
+def test_malformed_design_file(tmp_path, capsys):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"gamma": [2.0, 2.0, 2.0, 2.0], "h": [0, 0, 0')
+    assert main(["validate", str(bad), "--out", str(tmp_path / "run")]) == 2
+    assert "malformed JSON" in one_line_error(capsys)
+    bad.write_text(json.dumps({"gamma": [2.0] * 4, "h": [0.0] * 4, "target": {"p_star": 1}}))
+    assert main(["validate", str(bad), "--grid", "8", "--out", str(tmp_path / "run")]) == 2
+    assert "target" in one_line_error(capsys)
+
+
+def test_missing_tamaas_says_how_to_install(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "tamaas", None)  # import tamaas -> ImportError
+    assert main(["validate", EXAMPLE, "--out", str(tmp_path / "run")]) == 2
+    assert "pip install tamaas" in one_line_error(capsys)
