@@ -119,18 +119,21 @@ def test_many_designs_write_as_they_go_and_resume(tmp_path):
     first = validate_many(folder, out, grid=64, loads=2, progress=False)
     assert set(first) == {"a"}
     stamp = (out / "a" / "result.json").stat().st_mtime_ns
-    cone = Design(gamma=np.array([1.8]), h=np.array([0.0]), settings=HERTZ.settings)
-    save_design(folder / "b.json", cone)
-    both = validate_many(folder, out, grid=64, loads=2, jobs=2, progress=False)
-    assert set(both) == {"a", "b"}
+    for name, gamma in (("b", 1.8), ("c", 3.0), ("d", 4.0)):
+        other = Design(gamma=np.array([gamma]), h=np.array([0.0]), settings=HERTZ.settings)
+        save_design(folder / f"{name}.json", other)
+    every = validate_many(folder, out, grid=64, loads=2, jobs=2, progress=False)
+    assert list(every) == ["a", "b", "c", "d"]
     assert (out / "a" / "result.json").stat().st_mtime_ns == stamp  # resumed, not redone
-    for name in ("a", "b"):
+    assert every["a"] == first["a"]
+    for name in ("a", "b", "c", "d"):
         header = (out / name / "bem.csv").read_text().splitlines()[1]
         assert header == "p_star,alpha_bem,alpha_model,rel_err,p_max"
         record = json.loads((out / name / "result.json").read_text())
         assert record["request"]["grid"] == 64 and record["summary"]["loads"] == 2
     summary = json.loads((out / "summary.json").read_text())
-    assert list(summary["designs"]) == ["a", "b"]
+    assert list(summary["designs"]) == ["a", "b", "c", "d"]
+    assert all(d["max_rel_err"] < 0.2 for d in summary["designs"].values())  # 64^2 only
     # other settings: computed again
     validate_many(folder, out, grid=32, loads=2, progress=False)
     assert (out / "a" / "result.json").stat().st_mtime_ns != stamp

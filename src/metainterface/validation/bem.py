@@ -17,7 +17,7 @@ import multiprocessing as mp
 import os
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
@@ -188,7 +188,7 @@ def available_cpus() -> int:
 
 
 def run_tasks(
-    tasks: list[dict[str, Any]],
+    tasks: Sequence[dict[str, Any] | Callable[[], dict[str, Any]]],
     jobs: int,
     *,
     progress: Callable[[int], Any] | None = None,
@@ -197,43 +197,56 @@ def run_tasks(
 ) -> list[LoadPath | None]:
     """Run ``solve_path(**task)`` for each task on up to ``jobs`` processes.
 
+    A task is a dict of keyword arguments, or a function returning one, called only when a
+    process is free (so a long sweep holds one height map per process, not one per design).
     progress(n) is called in this process as loads finish; on_done(i, result) as each task
-    finishes. A failing task raises at once (other workers are stopped) unless ``on_error``
-    is given, which then receives it and the task's slot stays None.
+    finishes (results are also returned, in order, unless on_done is given). A failing task
+    raises at once (other workers are stopped) unless ``on_error`` is given, which then
+    receives it and the task's slot stays None.
     """
     results: list[LoadPath | None] = [None] * len(tasks)
+
+    def kwargs(i: int) -> dict[str, Any]:
+        task = tasks[i]
+        return task() if callable(task) else task
+
+    def finish(i: int, get: Callable[[], LoadPath]) -> None:
+        try:
+            path = get()
+        except MetainterfaceError as exc:
+            if on_error is None:
+                raise
+            on_error(i, exc)
+            return
+        if on_done is None:
+            results[i] = path
+        else:
+            on_done(i, path)
+
     if jobs <= 1 or len(tasks) <= 1:
-        for i, task in enumerate(tasks):
-            try:
-                results[i] = solve_path(**task, report=progress)
-            except MetainterfaceError as exc:
-                if on_error is None:
-                    raise
-                on_error(i, exc)
-                continue
-            if on_done is not None:
-                on_done(i, results[i])
+        for i in range(len(tasks)):
+            finish(i, lambda i=i: solve_path(**kwargs(i), report=progress))
         return results
     ctx = _context()
     queue = ctx.Queue()
-    pool = ctx.Pool(min(jobs, len(tasks)), initializer=_init_worker, initargs=(queue,))
+    workers = min(jobs, len(tasks))
+    pool = ctx.Pool(workers, initializer=_init_worker, initargs=(queue,))
     try:
-        pending = {i: pool.apply_async(_solve_task, (task,)) for i, task in enumerate(tasks)}
-        while pending:
-            for i, res in list(pending.items()):
-                if not res.ready():
-                    continue
-                del pending[i]
-                try:
-                    results[i] = res.get()
-                except MetainterfaceError as exc:
-                    if on_error is None:
-                        raise
-                    on_error(i, exc)
-                    continue
-                if on_done is not None:
-                    on_done(i, results[i])
-            _drain(queue, progress, block=bool(pending))
+        waiting = iter(range(len(tasks)))
+        running: dict[int, Any] = {}
+        while True:
+            while len(running) < workers:  # keep every process busy, no more
+                i = next(waiting, None)
+                if i is None:
+                    break
+                running[i] = pool.apply_async(_solve_task, (kwargs(i),))
+            if not running:
+                break
+            for i, res in list(running.items()):
+                if res.ready():
+                    del running[i]
+                    finish(i, res.get)
+            _drain(queue, progress, block=bool(running))
         pool.close()
         pool.join()
     finally:

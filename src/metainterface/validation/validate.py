@@ -160,7 +160,11 @@ def design_target(design: Design) -> tuple[np.ndarray, np.ndarray] | None:
 
 @dataclass(frozen=True)
 class ValidationPlan:
-    """A checked validation case, ready to solve: ``plan_validation(...).solve(jobs)``."""
+    """A checked validation case, ready to solve: ``plan_validation(...).solve(jobs)``.
+
+    Light on purpose (no grids, no dense curves), so a sweep can plan thousands of designs.
+    loads: (K,) the P* of the path, ascending.
+    """
 
     name: str
     design: Design
@@ -169,21 +173,30 @@ class ValidationPlan:
     tolerance: float
     max_iter: int
     loads: np.ndarray
-    curve: ModelCurve
-    heights: HeightMap
 
-    def task(self) -> dict[str, Any]:
+    def model(self) -> ModelCurve:
+        """The forward model's dense curve (``models.model_curve``)."""
+        return model_curve(self.design, self.physics)
+
+    def height_map(self) -> HeightMap:
+        """The cell's M x M height map."""
+        return height_map(self.design, self.grid)
+
+    def task(self, heights: HeightMap | None = None) -> dict[str, Any]:
+        """Keyword arguments of ``bem.solve_path`` / ``bem.solve_loads`` for this case."""
+        hm = self.height_map() if heights is None else heights
         return dict(
-            heights=self.heights.heights,
-            cell_side=self.heights.cell_side,
+            heights=hm.heights,
+            cell_side=hm.cell_side,
             loads=self.loads,
-            owner=self.heights.owner,
+            owner=hm.owner,
             n_asperities=self.design.n_asperities,
             tolerance=self.tolerance,
             max_iter=self.max_iter,
         )
 
     def request(self) -> dict[str, Any]:
+        """What a stored result must match to be reused (see ``validate_many``)."""
         return _request(
             self.design, self.grid, self.loads, self.physics, self.tolerance, self.max_iter
         )
@@ -192,16 +205,24 @@ class ValidationPlan:
         self, jobs: int = 1, progress: Callable[[int], Any] | None = None
     ) -> ValidationResult:
         """Run the BEM load path on ``jobs`` processes; progress(n) as loads finish."""
-        # PKR needs more iterations as contacts grow: about alpha^(1/8) (measured, 384^2 and
-        # 768^2 paths). Balancing the chunks on that keeps both processes busy to the end.
-        weights = np.maximum(self.curve.at(self.loads)[0], 1e-12) ** 0.125
-        path = solve_loads(
-            **self.task(), jobs=_check_jobs(jobs), weights=weights, progress=progress
-        )
-        return self.result(path)
+        jobs = _check_jobs(jobs)
+        heights, curve = self.height_map(), self.model()
+        # PKR needs more iterations as contacts grow, roughly alpha^(1/8) (measured on 384^2
+        # paths: 61 -> 82 iterations). Balanced chunks keep every process busy to the end.
+        weights = np.maximum(curve.at(self.loads)[0], 1e-12) ** 0.125
+        path = solve_loads(**self.task(heights), jobs=jobs, weights=weights, progress=progress)
+        return self.result(path, heights=heights, curve=curve)
 
-    def result(self, path: LoadPath) -> ValidationResult:
-        alpha_model, per_model = self.curve.at(self.loads)
+    def result(
+        self,
+        path: LoadPath,
+        *,
+        heights: HeightMap | None = None,
+        curve: ModelCurve | None = None,
+    ) -> ValidationResult:
+        """Assemble the result of a solved load path (model evaluated at the same P*)."""
+        curve = self.model() if curve is None else curve
+        alpha_model, per_model = curve.at(self.loads)
         return ValidationResult(
             name=self.name,
             design=self.design,
@@ -218,8 +239,8 @@ class ValidationPlan:
             residual=path.residual,
             seconds=path.seconds,
             pressure=path.pressure,
-            heights=self.heights,
-            model=self.curve,
+            heights=self.height_map() if heights is None else heights,
+            model=curve,
         )
 
 
@@ -233,15 +254,17 @@ def plan_validation(
     tolerance: float = TOLERANCE,
     max_iter: int = MAX_ITER,
 ) -> ValidationPlan:
-    """Check the inputs and build everything but the BEM solve (see ``validate_design``)."""
-    if not (isinstance(max_iter, int | np.integer) and max_iter >= 1):
+    """Check every input and fix the load path; the BEM solve is ``.solve(jobs)``.
+
+    Arguments as in ``validate_design``. Raises MetainterfaceError on bad input.
+    """
+    if isinstance(max_iter, bool) or not (isinstance(max_iter, int | np.integer) and max_iter >= 1):
         raise MetainterfaceError(f"max_iter must be a whole number >= 1, got {max_iter!r}")
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise MetainterfaceError(f"tolerance must be a number > 0, got {tolerance!r}")
     grid = default_grid(design.settings) if grid is None else check_grid(grid, design.settings)
     design_target(design)  # a malformed target fails now, not after the solve
-    curve = model_curve(design, physics)  # the one place the forward model is evaluated
-    path = resolve_loads(loads, curve.p_star_max)
+    p_top = model_curve(design, physics).p_star_max
     return ValidationPlan(
         name=name,
         design=design,
@@ -249,9 +272,7 @@ def plan_validation(
         physics=physics,
         tolerance=float(tolerance),
         max_iter=int(max_iter),
-        loads=path,
-        curve=curve,
-        heights=height_map(design, grid),
+        loads=resolve_loads(loads, p_top),
     )
 
 
@@ -496,7 +517,8 @@ def validate_many(
             bar.update(1)
 
     try:
-        run_tasks([p.task() for p in todo], jobs, on_done=on_done, on_error=on_error)
+        # tasks are built (height maps computed) only as processes take them
+        run_tasks([p.task for p in todo], jobs, on_done=on_done, on_error=on_error)
     finally:
         if bar is not None:
             bar.close()
