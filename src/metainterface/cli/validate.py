@@ -90,7 +90,8 @@ def run(args: argparse.Namespace) -> int:
     k = len(result.p_star)
     print(
         f"{args.out}: {k} loads on {result.grid}x{result.grid}, "
-        f"BEM {result.seconds.sum():.1f} s of solver time; max p/E* = {result.p_max.max():.4g}"
+        f"solves {result.seconds.sum():.1f} s (summed over {jobs} processes); "
+        f"max p/E* = {result.p_max.max():.4g}"
     )
     print(
         f"largest relative error over the upper half of the loads "
