@@ -15,7 +15,15 @@ from collections.abc import Sequence
 from metainterface.errors import MetainterfaceError
 
 # Subcommand modules, in the order `--help` lists them.
-COMMANDS: tuple[str, ...] = ("curve", "generate", "export", "validate")
+COMMANDS: tuple[str, ...] = (
+    "design",
+    "curve",
+    "generate",
+    "train",
+    "evaluate",
+    "export",
+    "validate",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

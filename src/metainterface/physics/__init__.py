@@ -4,6 +4,7 @@ from metainterface.physics.cell import CellSettings, Design, validate_batch
 from metainterface.physics.curves import (
     Curve,
     Sweep,
+    alpha_at,
     anchor,
     curve,
     curves_numpy,
@@ -31,6 +32,7 @@ __all__ = [
     "Curve",
     "Design",
     "Sweep",
+    "alpha_at",
     "anchor",
     "area",
     "contact_radius",

@@ -204,6 +204,26 @@ def curve(
     return to_grid(sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta), settings.n_steps)
 
 
+def alpha_at(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_star: Tensor,
+    *,
+    smooth: float | None = None,
+    n_delta: int | None = None,
+) -> tuple[Tensor, Tensor]:
+    """alpha of (B, N) designs at given pressures p_star (B, M), and P*_max (B,).
+
+    Beyond a design's P*_max its alpha is held at the last value (the convention of the
+    relative curve error and of the refinement's undershoot term).
+    """
+    sw = sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta)
+    zero = torch.zeros_like(sw.p_star[:, :1])
+    p = torch.cat([zero, sw.p_star], dim=-1)
+    return interp(p_star, p, torch.cat([zero, sw.alpha], dim=-1)), p[:, -1]
+
+
 def curves_numpy(
     gamma: np.ndarray,
     h: np.ndarray,

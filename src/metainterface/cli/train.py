@@ -1,0 +1,78 @@
+"""`metainterface train`: train the inverse surrogate, or plot a run's training panels."""
+
+from __future__ import annotations
+
+import argparse
+
+from metainterface.cli.common import positive_int
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "train",
+        help="train the inverse surrogate through the physics layer (or --plot a run)",
+        description="Train the MLP of the paper on a dataset from `metainterface generate`. "
+        "The run folder gets checkpoint.pt (resumable), model.pt (best), metrics.csv.",
+    )
+    p.add_argument("--dataset", help="dataset .npz from `metainterface generate`")
+    p.add_argument("--out", help="run folder")
+    p.add_argument("--epochs", type=positive_int, default=500)
+    p.add_argument("--batch-size", type=positive_int, default=1024)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--lr", type=float, default=2e-3, help="peak learning rate (AdamW)")
+    p.add_argument("--patience", type=positive_int, default=50, help="early-stopping patience")
+    p.add_argument(
+        "--curriculum-epochs",
+        type=int,
+        default=20,
+        help="epochs over which the parameter anchor lambda falls linearly to 0",
+    )
+    p.add_argument("--resume", action="store_true", help="continue the run in --out")
+    p.add_argument("--plot", metavar="RUN_DIR", help="draw the training panels of a run")
+    p.add_argument("--figure", help="with --plot: figure path (default RUN_DIR/training.png)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from metainterface.errors import MetainterfaceError
+
+    if args.plot:
+        from metainterface.plots import plot_training, save_figure
+        from metainterface.surrogate.train import read_metrics
+
+        fig_path = args.figure or str(Path(args.plot) / "training.png")
+        save_figure(plot_training(read_metrics(args.plot)), fig_path, command="train --plot")
+        print(f"{fig_path}: training panels of {args.plot}")
+        return 0
+    if not (args.dataset and args.out):
+        raise MetainterfaceError("train needs --dataset FILE and --out RUN_DIR (or --plot RUN_DIR)")
+    from metainterface.data import load_dataset
+    from metainterface.surrogate.data import split_of
+    from metainterface.surrogate.train import TrainConfig, train
+
+    ds = load_dataset(args.dataset)
+    config = TrainConfig(
+        epochs=args.epochs,
+        batch_size=args.batch_size,
+        seed=args.seed,
+        lr=args.lr,
+        patience=args.patience,
+        curriculum_epochs=args.curriculum_epochs,
+    )
+    result = train(
+        split_of(ds, "train"),
+        split_of(ds, "val"),
+        ds.settings,
+        args.out,
+        config,
+        resume=args.resume,
+        dataset_info={"path": str(args.dataset), "samples": len(ds), "seed": ds.seed},
+    )
+    print(
+        f"{result.run_dir}: {result.epochs_run} epochs in {result.seconds:.0f} s, best "
+        f"validation loss {result.best_val_loss:.4f} at epoch {result.best_epoch}"
+        + (" (early stop)" if result.stopped_early else "")
+    )
+    return 0

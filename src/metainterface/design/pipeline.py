@@ -1,0 +1,194 @@
+"""The design loop: targets in, unit cells out (paper sec. 4, appendix C).
+
+Methods: ``surrogate`` (zero-shot prediction by the inverse MLP, then refinement),
+``multistart`` (K random starts, refined, best kept) and ``hertz`` (gamma fixed at 2, heights
+only, K starts). Several targets, and all their starts, are refined together as one batch of
+independent problems.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from metainterface.design.refine import (
+    DTYPE,
+    RefineSettings,
+    TargetGrid,
+    from_design,
+    refine,
+    relative_error,
+    to_design,
+)
+from metainterface.design.targets import Target, target_features
+from metainterface.errors import MetainterfaceError
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.curves import alpha_at
+
+METHODS = ("surrogate", "multistart", "hertz")
+
+
+@dataclass(frozen=True)
+class DesignResult:
+    """A designed cell for one target: gamma, h (N,); relative curve error; wall seconds."""
+
+    target: Target
+    method: str
+    gamma: np.ndarray
+    h: np.ndarray
+    error: float
+    seconds: float
+    initial_error: float
+    settings: CellSettings
+
+
+def _starts(
+    count: int, n_targets: int, settings: CellSettings, seed: int, hertz: bool
+) -> tuple[Tensor, Tensor]:
+    gen = torch.Generator().manual_seed(seed)
+    shape = (n_targets * count, settings.n_asperities)
+    u = torch.rand(shape, generator=gen, dtype=DTYPE)
+    gamma = (
+        torch.full(shape, 2.0, dtype=DTYPE)
+        if hertz
+        else (settings.gamma_min + (settings.gamma_max - settings.gamma_min) * u)
+    )
+    h = settings.delta_max * torch.rand(shape, generator=gen, dtype=DTYPE)
+    return gamma, h
+
+
+def predict(
+    model: torch.nn.Module, targets: Sequence[Target], settings: CellSettings
+) -> tuple[Tensor, Tensor]:
+    """Zero-shot designs (T, N) for the targets from the surrogate."""
+    from metainterface.surrogate.model import outputs_to_design
+
+    feats = torch.stack([target_features(t, settings.n_steps) for t in targets])
+    model.eval()
+    with torch.no_grad():
+        gamma, h = outputs_to_design(model(feats), settings)
+    return gamma.to(DTYPE), h.to(DTYPE)
+
+
+def design(
+    targets: Sequence[Target],
+    method: str = "surrogate",
+    *,
+    refine_designs: bool = True,
+    settings: CellSettings | None = None,
+    model_path: str | os.PathLike[str] | None = None,
+    starts: int = 50,
+    seed: int = 0,
+    refine_settings: RefineSettings | None = None,
+    extra_loss: Callable[[Tensor, Tensor], Tensor] | None = None,
+) -> list[DesignResult]:
+    """Design one cell per target with ``method``; returns one result per target."""
+    if method not in METHODS:
+        raise MetainterfaceError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    if starts < 1:
+        raise MetainterfaceError(f"starts must be >= 1, got {starts}")
+    if not targets:
+        raise MetainterfaceError("no target given")
+    refine_settings = refine_settings or RefineSettings()
+    t0 = time.perf_counter()
+    if method == "surrogate":
+        from metainterface.surrogate.checkpoint import default_model_path, load_model
+
+        model, model_settings, _ = load_model(model_path or default_model_path())
+        if (
+            settings is not None
+            and settings.with_(n_steps=model_settings.n_steps) != model_settings
+        ):
+            raise MetainterfaceError(
+                f"the surrogate was trained for another cell ({model_settings.to_dict()}); "
+                "use --method multistart for these settings or train a model for them"
+            )
+        settings = model_settings
+        gamma0, h0 = predict(model, targets, settings)
+        per_target, hertz = 1, False
+    else:
+        settings = settings or CellSettings()
+        hertz = method == "hertz"
+        per_target = starts
+        gamma0, h0 = _starts(starts, len(targets), settings, seed, hertz)
+    grid = TargetGrid.from_curves(
+        [(t.p_star, t.alpha) for t in targets], refine_settings.grid_points
+    )
+    rows = grid.rows(torch.arange(len(targets)).repeat_interleave(per_target))
+    # the starts as the refinement sees them (sorted, anchored, inside the bounds)
+    raw = from_design(gamma0, h0, settings, hertz)
+    gamma_i, h_i = to_design(raw, settings, hertz)
+    err0 = relative_error(gamma_i, h_i, settings, rows)
+    if refine_designs:
+        raw = refine(raw, settings, rows, refine_settings, hertz, extra_loss)
+    gamma, h = to_design(raw.detach(), settings, hertz)
+    err = relative_error(gamma, h, settings, rows)
+    best = err.view(len(targets), per_target).argmin(-1) + torch.arange(len(targets)) * per_target
+    seconds = (time.perf_counter() - t0) / len(targets)
+    return [
+        DesignResult(
+            target=t,
+            method=method,
+            gamma=gamma[b].detach().numpy().copy(),
+            h=h[b].detach().numpy().copy(),
+            error=float(err[b]),
+            seconds=seconds,
+            initial_error=float(err0.view(len(targets), per_target)[i].min()),
+            settings=settings,
+        )
+        for i, (t, b) in enumerate(zip(targets, best.tolist(), strict=True))
+    ]
+
+
+def reachable_envelope(
+    p_star: np.ndarray, settings: CellSettings, samples: int = 2000, seed: int = 0
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """An estimate of the alpha range reachable at each pressure (M,): (lo, hi, P*_reach).
+
+    From a fixed family of designs: uniform cells over a gamma grid at h = 0, single active
+    asperities, and ``samples`` random cells; P*_reach is the largest pressure any reaches.
+    """
+    n = settings.n_asperities
+    gammas = torch.linspace(settings.gamma_min, settings.gamma_max, 12, dtype=DTYPE)
+    uniform = gammas[:, None].expand(-1, n)
+    single_h = torch.full((12, n), 3 * settings.delta_max, dtype=DTYPE)
+    single_h[:, 0] = 0.0
+    g_r, h_r = _starts(samples, 1, settings, seed, hertz=False)
+    gamma = torch.cat([uniform, uniform, g_r])
+    h = torch.cat([torch.zeros(12, n, dtype=DTYPE), single_h, h_r])
+    p = torch.as_tensor(p_star, dtype=DTYPE)[None].expand(gamma.shape[0], -1)
+    with torch.no_grad():
+        alpha, p_max = alpha_at(gamma, h, settings, p)
+    reached = p <= p_max[:, None]
+    lo = torch.where(reached, alpha, torch.inf).amin(0)
+    hi = torch.where(reached, alpha, -torch.inf).amax(0)
+    return lo.numpy(), hi.numpy(), float(p_max.max())
+
+
+def reachability_warnings(
+    target: Target, settings: CellSettings, tolerance: float = 0.05
+) -> list[str]:
+    """Human-readable warnings where the target leaves the reachable envelope."""
+    lo, hi, p_reach = reachable_envelope(target.p_star, settings)
+    out = []
+    if target.p_star_max > p_reach:
+        out.append(
+            f"target {target.name}: P* = {target.p_star_max:.4g} is beyond the largest pressure "
+            f"any design in the bounds reaches at Delta_max ({p_reach:.4g})"
+        )
+    ok = np.isfinite(lo) & (target.p_star > 0)
+    outside = ok & ((target.alpha < lo * (1 - tolerance)) | (target.alpha > hi * (1 + tolerance)))
+    if outside.any():
+        i = int(np.flatnonzero(outside)[0])
+        out.append(
+            f"target {target.name}: alpha = {target.alpha[i]:.4g} at P* = {target.p_star[i]:.4g} "
+            f"is outside the reachable envelope there, alpha in [{lo[i]:.4g}, {hi[i]:.4g}] "
+            f"({int(outside.sum())} of {target.p_star.size} points outside)"
+        )
+    return out

@@ -1,0 +1,166 @@
+"""Design targets: alpha(P*) curves to reproduce, built in or read from CSV.
+
+Built-in targets (the three out-of-distribution targets of the paper's sec. 4), all for the
+default cell (N = 9, R = 1, Delta_max = R/50, gamma in [1.8, 4]):
+
+* ``saturating``: the exact curve of a cell of nine identical, moderately blunt asperities
+  (gamma = 3.2) engaging almost together (h_k = k * 0.0125 Delta_max, k = 0..8): the area
+  grows steeply, then saturates.
+* ``bilinear``: the exact curve of a cell with two groups: four Hertzian asperities
+  (gamma = 2) at h = 0 and five blunt ones (gamma = 3.6) at h = 0.45 Delta_max: the stiffness
+  jumps when the second group engages.
+* ``linear``: alpha = 25 P* for P* in [0, 0.002], synthetic (a constant friction coefficient
+  over the whole range); 128 points.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from metainterface.errors import MetainterfaceError
+from metainterface.io.csvfiles import read_columns
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.curves import sweep
+
+
+@dataclass(frozen=True)
+class Target:
+    """A target curve: name, P* (M,) strictly increasing from ~0, alpha (M,) >= 0.
+
+    stiffness: optional (M,) S* = dP*/dalpha at the same points (exact for built-ins).
+    source: where it came from (a built-in's definition or a file path).
+    """
+
+    name: str
+    p_star: np.ndarray
+    alpha: np.ndarray
+    stiffness: np.ndarray | None = None
+    source: str = ""
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def p_star_max(self) -> float:
+        return float(self.p_star[-1])
+
+
+def _design_target(name: str, gamma: list[float], h_frac: list[float], source: str) -> Target:
+    s = CellSettings()
+    g = torch.tensor([gamma], dtype=torch.float64)
+    h = torch.tensor([h_frac], dtype=torch.float64) * s.delta_max
+    sw = sweep(g, h, s, n_delta=256)
+    return Target(
+        name,
+        sw.p_star[0].numpy(),
+        sw.alpha[0].numpy(),
+        sw.stiffness[0].numpy(),
+        source,
+        {"gamma": gamma, "h": (h[0] / 1).tolist()},
+    )
+
+
+def _saturating() -> Target:
+    return _design_target(
+        "saturating",
+        [3.2] * 9,
+        [0.0125 * k for k in range(9)],
+        "nine gamma = 3.2 asperities at h_k = k * 0.0125 Delta_max",
+    )
+
+
+def _bilinear() -> Target:
+    return _design_target(
+        "bilinear",
+        [2.0] * 4 + [3.6] * 5,
+        [0.0] * 4 + [0.45] * 5,
+        "four gamma = 2 asperities at h = 0, five gamma = 3.6 at h = 0.45 Delta_max",
+    )
+
+
+def _linear() -> Target:
+    p = np.linspace(0.0, 0.002, 128)
+    return Target("linear", p, 25.0 * p, np.full_like(p, 1 / 25.0), "alpha = 25 P*, P* <= 0.002")
+
+
+BUILTIN_TARGETS: dict[str, Callable[[], Target]] = {
+    "saturating": _saturating,
+    "bilinear": _bilinear,
+    "linear": _linear,
+}
+
+
+def builtin_target(name: str) -> Target:
+    """One of the built-in targets by name."""
+    try:
+        return BUILTIN_TARGETS[name]()
+    except KeyError:
+        raise MetainterfaceError(
+            f"unknown target {name!r}; built-in targets are {', '.join(BUILTIN_TARGETS)}"
+        ) from None
+
+
+def check_target(name: str, p_star: np.ndarray, alpha: np.ndarray, where: str) -> None:
+    """Validate a target curve; errors name the row (1-based) and the rule broken."""
+    if p_star.size < 3:
+        raise MetainterfaceError(f"{where}: a target needs at least 3 points, got {p_star.size}")
+    for col, arr in (("p_star", p_star), ("alpha", alpha)):
+        bad = np.flatnonzero(~np.isfinite(arr))
+        if bad.size:
+            raise MetainterfaceError(f"{where}: row {bad[0] + 1}: {col} is not a finite number")
+        bad = np.flatnonzero(arr < 0)
+        if bad.size:
+            raise MetainterfaceError(
+                f"{where}: row {bad[0] + 1}: {col} = {arr[bad[0]]:g} is negative"
+            )
+    bad = np.flatnonzero(np.diff(p_star) <= 0)
+    if bad.size:
+        raise MetainterfaceError(
+            f"{where}: row {bad[0] + 2}: p_star must be strictly increasing "
+            f"({p_star[bad[0] + 1]:g} after {p_star[bad[0]]:g})"
+        )
+    if p_star[0] > 0.05 * p_star[-1]:
+        raise MetainterfaceError(
+            f"{where}: row 1: p_star = {p_star[0]:g} must start at 0 or near it "
+            f"(<= 5 % of the largest pressure, {p_star[-1]:g})"
+        )
+    if alpha[-1] <= 0:
+        raise MetainterfaceError(f"{where}: alpha must become positive")
+
+
+def target_from_csv(path: str | os.PathLike[str], name: str | None = None) -> Target:
+    """A target from a CSV with header ``p_star,alpha`` (>= 3 rows, p_star increasing from ~0)."""
+    cols = read_columns(path, ("p_star", "alpha"))
+    p, a = cols["p_star"], cols["alpha"]
+    check_target(name or Path(path).stem, p, a, str(path))
+    return Target(name or Path(path).stem, p, a, None, str(path))
+
+
+def target_grid(target: Target, n: int = 128) -> tuple[np.ndarray, np.ndarray]:
+    """The target on n uniform pressures over [0, P*_max]: (p (n,), alpha (n,))."""
+    grid = np.linspace(0.0, target.p_star_max, n)
+    return grid, np.interp(grid, target.p_star, target.alpha, left=0.0)
+
+
+def target_features(target: Target, n_steps: int = 128, s_hat_max: float = 20.0) -> torch.Tensor:
+    """The surrogate's input (2 n_steps + 2,) for a target: alpha_hat, S_hat, log10 scalars.
+
+    S* comes from the target's own stiffness where it has one, else from finite differences
+    of alpha(P*); S_hat is clipped to [0, s_hat_max] (steep targets have unbounded S_hat).
+    """
+    grid, alpha = target_grid(target, n_steps)
+    a_max, p_max = float(alpha[-1]), target.p_star_max
+    if target.stiffness is not None:
+        stiff = np.interp(grid, target.p_star, target.stiffness)
+    else:
+        slope = np.gradient(alpha, grid)
+        stiff = np.where(slope > 0, 1.0 / np.maximum(slope, 1e-300), 0.0)
+    s_hat = np.clip(stiff * a_max / p_max, 0.0, s_hat_max)
+    return torch.as_tensor(
+        np.concatenate([alpha / a_max, s_hat, [np.log10(p_max), np.log10(a_max)]]),
+        dtype=torch.float32,
+    )

@@ -1,0 +1,77 @@
+"""What `design` writes for each target: design.json, target.csv, curve.csv, design.png."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from metainterface.io.csvfiles import write_columns
+from metainterface.io.design_file import save_design
+from metainterface.physics.cell import Design
+from metainterface.physics.curves import design_sweep
+
+
+def write_design_outputs(
+    folder: Path,
+    result: Any,
+    *,
+    args: argparse.Namespace | None = None,
+    pressure_limit: float | None = None,
+    e_star: float | None = None,
+) -> Path:
+    """Write the four outputs of one designed cell into ``folder``; returns design.json."""
+    t = result.target
+    d = Design(gamma=result.gamma, h=result.h, settings=result.settings)
+    extra: dict[str, Any] = {
+        "target": {
+            "name": t.name,
+            "source": t.source,
+            "p_star": t.p_star.tolist(),
+            "alpha": t.alpha.tolist(),
+            **t.meta,
+        },
+        "method": result.method,
+        "relative_error": result.error,
+        "zero_shot_error": result.initial_error,
+        "seconds": result.seconds,
+    }
+    if args is not None:
+        extra["command"] = {k: v for k, v in vars(args).items() if k != "func"}
+    if pressure_limit is not None:
+        from metainterface.physics.limits import check_pressure
+
+        extra["pressure_check"] = check_pressure(d, pressure_limit, e_star=e_star).to_dict()
+    if args is not None and args.radius and args.modulus:
+        from metainterface.io.physical import physical_block
+        from metainterface.io.units import parse_area, parse_force, parse_length, parse_pressure
+
+        extra["physical"] = physical_block(
+            d,
+            radius=parse_length(args.radius, option="--radius"),
+            e_star=parse_pressure(args.modulus, option="--modulus"),
+            total_force=parse_force(args.total_force, option="--total-force")
+            if args.total_force
+            else None,
+            area=parse_area(args.area, option="--area")
+            if args.area and not args.total_force
+            else None,
+        )
+    folder.mkdir(parents=True, exist_ok=True)
+    write_columns(folder / "target.csv", {"p_star": t.p_star, "alpha": t.alpha}, target=t.name)
+    sw = design_sweep(d, n_delta=256)
+    write_columns(
+        folder / "curve.csv",
+        {
+            "delta": sw.delta.numpy(),
+            "p_star": sw.p_star[0].numpy(),
+            "alpha": sw.alpha[0].numpy(),
+            "stiffness": sw.stiffness[0].numpy(),
+        },
+        target=t.name,
+        method=result.method,
+    )
+    from metainterface.plots import plot_design, save_figure
+
+    save_figure(plot_design(result), folder / "design.png", target=t.name, method=result.method)
+    return save_design(folder / "design.json", d, **extra)

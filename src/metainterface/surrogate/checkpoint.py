@@ -1,0 +1,69 @@
+"""Model files and training checkpoints: plain state dicts, loaded with weights_only=True.
+
+A model file holds {"format", "config", "state_dict"}: config is JSON-ready (cell settings,
+architecture, training summary, package version); nothing is ever unpickled.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from pathlib import Path
+from typing import Any
+
+import torch
+
+from metainterface.errors import MetainterfaceError
+from metainterface.io.atomic import write_bytes
+from metainterface.physics.cell import CellSettings
+from metainterface.surrogate.model import InverseMLP
+
+MODEL_FORMAT = "metainterface/surrogate-v1"
+
+
+def save_torch(path: str | os.PathLike[str], obj: Any) -> Path:
+    """torch.save, atomically (write then rename)."""
+    buf = io.BytesIO()
+    torch.save(obj, buf)
+    return write_bytes(path, buf.getvalue())
+
+
+def load_torch(path: str | os.PathLike[str], what: str = "file") -> Any:
+    """torch.load with weights_only=True; one-line errors for missing or foreign files."""
+    path = Path(path)
+    if not path.is_file():
+        raise MetainterfaceError(f"{what} {path}: file not found")
+    try:
+        return torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as exc:  # corrupt, truncated or unsafe content
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise MetainterfaceError(
+            f"{what} {path}: not a readable weights file ({first[:120]})"
+        ) from None
+
+
+def save_model(path: str | os.PathLike[str], model: InverseMLP, config: dict[str, Any]) -> Path:
+    """Write a model file (weights + JSON-ready config) atomically."""
+    state = {k: v.detach().clone() for k, v in model.state_dict().items()}
+    return save_torch(path, {"format": MODEL_FORMAT, "config": config, "state_dict": state})
+
+
+def load_model(path: str | os.PathLike[str]) -> tuple[InverseMLP, CellSettings, dict[str, Any]]:
+    """Read a model file -> (model in eval mode, its cell settings, its config)."""
+    blob = load_torch(path, "model")
+    if not isinstance(blob, dict) or blob.get("format") != MODEL_FORMAT:
+        raise MetainterfaceError(f"model {path}: not a metainterface surrogate ({MODEL_FORMAT})")
+    config = blob["config"]
+    try:
+        settings = CellSettings(**config["settings"])
+        model = InverseMLP(settings.n_asperities, settings.n_steps)
+        model.load_state_dict(blob["state_dict"])
+    except (KeyError, TypeError, RuntimeError) as exc:
+        raise MetainterfaceError(f"model {path}: inconsistent weights file ({exc})") from None
+    model.eval()
+    return model, settings, config
+
+
+def default_model_path() -> Path:
+    """The surrogate shipped with the package."""
+    return Path(__file__).resolve().parents[1] / "weights" / "surrogate.pt"

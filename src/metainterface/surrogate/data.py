@@ -1,0 +1,54 @@
+"""Tensors for training and evaluation, from a dataset file of the generator."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from metainterface.data.dataset import Dataset
+from metainterface.physics.curves import features_from_normalised
+from metainterface.surrogate.loss import CurveTargets
+
+
+@dataclass(frozen=True)
+class Split:
+    """One split of a dataset as float32 tensors (S rows)."""
+
+    features: Tensor  # (S, 2n + 2)
+    targets: CurveTargets
+    gamma: Tensor  # (S, N)
+    h: Tensor  # (S, N)
+    category: np.ndarray  # (S,) str
+
+    def __len__(self) -> int:
+        return self.features.shape[0]
+
+    def rows(self, idx: Tensor) -> tuple[Tensor, CurveTargets, Tensor, Tensor]:
+        t = self.targets
+        return (
+            self.features[idx],
+            CurveTargets(
+                t.alpha_hat[idx], t.stiffness_hat[idx], t.p_star_max[idx], t.alpha_max[idx]
+            ),
+            self.gamma[idx],
+            self.h[idx],
+        )
+
+
+def split_of(dataset: Dataset, name: str) -> Split:
+    """The rows of a loaded dataset whose split is ``name`` (train, val or test)."""
+    sub = dataset.subset(name)
+
+    def f32(a: np.ndarray) -> Tensor:
+        return torch.as_tensor(a, dtype=torch.float32)
+
+    targets = CurveTargets(
+        f32(sub.alpha_hat), f32(sub.stiffness_hat), f32(sub.p_star_max), f32(sub.alpha_max)
+    )
+    feats = features_from_normalised(
+        targets.alpha_hat, targets.stiffness_hat, targets.p_star_max, targets.alpha_max
+    )
+    return Split(feats, targets, f32(sub.gamma), f32(sub.h), np.asarray(sub.category))

@@ -1,0 +1,109 @@
+"""Zero-shot quality of a surrogate on the test split, per topography category.
+
+Relative curve error: ||alpha_pred - alpha_true||_2 / ||alpha_true||_2 on the 128-point
+pressure grid of each test curve, alpha_pred from the exact forward model of the predicted
+design (held at its last value beyond its P*_max). Also the absolute errors of log10 P*_max and
+log10 alpha_max, and the train/test loss gap (exact physics, eval mode).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.curves import alpha_at, curve
+from metainterface.surrogate.data import Split
+from metainterface.surrogate.model import InverseMLP, outputs_to_design
+from metainterface.surrogate.train import evaluate_loss
+
+
+@dataclass(frozen=True)
+class Predictions:
+    """Per test sample: relative curve error, log10 errors; predicted designs (S, N)."""
+
+    category: np.ndarray
+    curve_error: np.ndarray
+    log_p_error: np.ndarray
+    log_alpha_error: np.ndarray
+    gamma: np.ndarray
+    h: np.ndarray
+
+
+def predict_split(
+    model: InverseMLP, split: Split, settings: CellSettings, chunk: int = 2048
+) -> Predictions:
+    model.eval()
+    errs, lp, la, gs, hs = [], [], [], [], []
+    with torch.no_grad():
+        for lo in range(0, len(split), chunk):
+            idx = torch.arange(lo, min(lo + chunk, len(split)))
+            feats, t, _, _ = split.rows(idx)
+            gamma, h = outputs_to_design(model(feats), settings)
+            gamma, h = gamma.double(), h.double()
+            p_grid = (
+                torch.linspace(0, 1, settings.n_steps, dtype=torch.float64)[None]
+                * t.p_star_max.double()[:, None]
+            )
+            alpha_true = t.alpha_hat.double() * t.alpha_max.double()[:, None]
+            alpha_pred, _ = alpha_at(gamma, h, settings, p_grid)
+            errs.append(
+                (
+                    torch.linalg.vector_norm(alpha_pred - alpha_true, dim=-1)
+                    / torch.linalg.vector_norm(alpha_true, dim=-1)
+                ).numpy()
+            )
+            c = curve(gamma, h, settings)
+            lp.append(
+                (torch.log10(c.p_star_max) - torch.log10(t.p_star_max.double())).abs().numpy()
+            )
+            la.append((torch.log10(c.alpha_max) - torch.log10(t.alpha_max.double())).abs().numpy())
+            gs.append(gamma.numpy())
+            hs.append(h.numpy())
+    cat = np.concatenate
+    return Predictions(split.category, cat(errs), cat(lp), cat(la), cat(gs), cat(hs))
+
+
+def evaluate(model: InverseMLP, train: Split, test: Split, settings: CellSettings) -> dict:
+    """The evaluation table: per category and overall, plus the train/test loss gap."""
+    pred = predict_split(model, test, settings)
+    rows = {}
+    for name in [*sorted(set(pred.category.tolist())), "all"]:
+        m = np.ones_like(pred.curve_error, bool) if name == "all" else pred.category == name
+        rows[name] = {
+            "samples": int(m.sum()),
+            "median_curve_error": float(np.median(pred.curve_error[m])),
+            "p90_curve_error": float(np.percentile(pred.curve_error[m], 90)),
+            "mean_abs_log10_p_star_max_error": float(pred.log_p_error[m].mean()),
+            "mean_abs_log10_alpha_max_error": float(pred.log_alpha_error[m].mean()),
+        }
+    train_loss = evaluate_loss(model, train, settings)
+    test_loss = evaluate_loss(model, test, settings)
+    return {
+        "categories": rows,
+        "train_loss": train_loss,
+        "test_loss": test_loss,
+        "loss_gap": (test_loss - train_loss) / train_loss,
+    }
+
+
+def format_table(result: dict) -> str:
+    """A markdown table of an :func:`evaluate` result."""
+    lines = [
+        "| category | samples | median curve error | p90 curve error "
+        "| abs log10 P*max err | abs log10 alpha_max err |",
+        "| --- | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for name, r in result["categories"].items():
+        lines.append(
+            f"| {name} | {r['samples']} | {100 * r['median_curve_error']:.2f} % | "
+            f"{100 * r['p90_curve_error']:.2f} % | {r['mean_abs_log10_p_star_max_error']:.4f} | "
+            f"{r['mean_abs_log10_alpha_max_error']:.4f} |"
+        )
+    lines.append(
+        f"\ntrain loss {result['train_loss']:.4f}, test loss {result['test_loss']:.4f}, "
+        f"gap {100 * result['loss_gap']:+.2f} %"
+    )
+    return "\n".join(lines)

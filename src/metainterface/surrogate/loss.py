@@ -1,0 +1,58 @@
+"""The composite loss of appendix A.2.
+
+L = w_shape (|alpha_hat - t|_1 + |S_hat - t|_1) + w_grad |diff S_hat - diff t|_1
+  + w_mag ((log10 P*_max - t)^2 + (log10 alpha_max - t)^2) + lambda L_param,
+with L_param the MSE of (gamma - gamma_min)/(gamma_max - gamma_min) and h / Delta_max.
+Norms are means over grid points and the batch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+from torch import Tensor
+
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.curves import Curve
+
+
+@dataclass(frozen=True)
+class LossWeights:
+    shape: float = 10.0
+    grad: float = 1.0
+    mag: float = 10.0
+
+
+@dataclass(frozen=True)
+class CurveTargets:
+    """Normalised target curves: alpha_hat, stiffness_hat (B, n); p_star_max, alpha_max (B,)."""
+
+    alpha_hat: Tensor
+    stiffness_hat: Tensor
+    p_star_max: Tensor
+    alpha_max: Tensor
+
+
+def physics_loss(pred: Curve, target: CurveTargets, w: LossWeights = LossWeights()) -> Tensor:
+    """Shape + magnitude loss of predicted curves against targets (a scalar)."""
+    s_hat = pred.stiffness_hat
+    shape = (pred.alpha_hat - target.alpha_hat).abs().mean() + (
+        s_hat - target.stiffness_hat
+    ).abs().mean()
+    grad = (s_hat.diff(dim=-1) - target.stiffness_hat.diff(dim=-1)).abs().mean()
+    mag = (
+        (torch.log10(pred.p_star_max) - torch.log10(target.p_star_max)) ** 2
+        + (torch.log10(pred.alpha_max) - torch.log10(target.alpha_max)) ** 2
+    ).mean()
+    return w.shape * shape + w.grad * grad + w.mag * mag
+
+
+def param_loss(
+    gamma: Tensor, h: Tensor, gamma_t: Tensor, h_t: Tensor, settings: CellSettings
+) -> Tensor:
+    """Normalised parameter MSE, the curriculum anchor (a scalar)."""
+    span = settings.gamma_max - settings.gamma_min
+    return torch.mean(((gamma - gamma_t) / span) ** 2) + torch.mean(
+        ((h - h_t) / settings.delta_max) ** 2
+    )

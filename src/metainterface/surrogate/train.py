@@ -1,0 +1,262 @@
+"""Training the inverse surrogate through the physics layer (paper sec. 3.2, appendix A).
+
+AdamW, cosine learning rate, the curriculum (lambda) and contact-regularisation (kappa_s)
+schedules, early stopping on the validation loss. The run folder holds:
+
+    checkpoint.pt  everything needed to resume (model, optimiser, scheduler, RNG, history),
+                   written atomically after every epoch: a killed run loses at most one epoch
+    model.pt       the best model so far (by validation loss), a model file for `design`
+    metrics.csv    per-epoch train/validation loss, kappa, lambda, learning rate, seconds
+    config.json    the settings of the run
+
+The validation loss is the physics loss with the exact contact law (what a designer gets),
+so it is comparable across epochs while kappa_s anneals.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from tqdm.auto import tqdm
+
+from metainterface.errors import MetainterfaceError
+from metainterface.io.atomic import write_text
+from metainterface.io.csvfiles import write_columns
+from metainterface.io.provenance import provenance
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.curves import curve
+from metainterface.surrogate.checkpoint import load_torch, save_model, save_torch
+from metainterface.surrogate.data import Split
+from metainterface.surrogate.loss import LossWeights, param_loss, physics_loss
+from metainterface.surrogate.model import InverseMLP, outputs_to_design
+from metainterface.surrogate.schedules import Schedules
+
+METRICS = ("epoch", "train_loss", "val_loss", "kappa", "lambda", "lr", "seconds")
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Hyper-parameters of a training run (all recorded in config.json and the model file).
+
+    physics_steps: Delta samples of the physics layer during training (the loss is still on
+    the curves' n_steps pressure grid); fewer samples make an epoch cheaper.
+    """
+
+    epochs: int = 500
+    batch_size: int = 1024
+    lr: float = 2e-3
+    weight_decay: float = 1e-4
+    patience: int = 50
+    seed: int = 0
+    curriculum_epochs: int = 20
+    lambda_start: float = 1.0
+    kappa_start: float = 1e3
+    kappa_end: float = 1e5
+    kappa_fraction: float = 0.25
+    physics_steps: int = 64
+
+    def __post_init__(self) -> None:
+        for name in ("epochs", "batch_size", "physics_steps"):
+            if getattr(self, name) < (2 if name != "epochs" else 1):
+                raise MetainterfaceError(f"{name} must be >= {2 if name != 'epochs' else 1}")
+        if not (self.lr > 0 and math.isfinite(self.lr)):
+            raise MetainterfaceError(f"lr must be > 0, got {self.lr}")
+        if self.patience < 1:
+            raise MetainterfaceError(f"patience must be >= 1, got {self.patience}")
+
+    @property
+    def schedules(self) -> Schedules:
+        return Schedules(
+            epochs=self.epochs,
+            kappa_start=self.kappa_start,
+            kappa_end=self.kappa_end,
+            kappa_fraction=self.kappa_fraction,
+            lambda_start=self.lambda_start,
+            curriculum_epochs=self.curriculum_epochs,
+        )
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    run_dir: Path
+    epochs_run: int
+    best_epoch: int
+    best_val_loss: float
+    stopped_early: bool
+    seconds: float
+
+
+def evaluate_loss(
+    model: InverseMLP, split: Split, settings: CellSettings, chunk: int = 4096
+) -> float:
+    """Mean exact-physics loss of the model on a split (no gradients, eval mode)."""
+    model.eval()
+    total = 0.0
+    with torch.no_grad():
+        for lo in range(0, len(split), chunk):
+            idx = torch.arange(lo, min(lo + chunk, len(split)))
+            feats, targets, _, _ = split.rows(idx)
+            gamma, h = outputs_to_design(model(feats), settings)
+            total += float(physics_loss(curve(gamma, h, settings), targets)) * len(idx)
+    return total / len(split)
+
+
+def _check_sizes(train: Split, val: Split, batch_size: int) -> None:
+    if len(train) < 2 or len(val) < 1:
+        raise MetainterfaceError(
+            f"dataset too small: {len(train)} training and {len(val)} validation samples"
+        )
+    if batch_size > len(train):
+        raise MetainterfaceError(
+            f"batch size {batch_size} is larger than the training split ({len(train)} samples)"
+        )
+
+
+def train(
+    train_split: Split,
+    val_split: Split,
+    settings: CellSettings,
+    out_dir: str | os.PathLike[str],
+    config: TrainConfig | None = None,
+    *,
+    resume: bool = False,
+    progress: bool = True,
+    dataset_info: dict[str, Any] | None = None,
+) -> TrainResult:
+    """Train (or resume) a surrogate in ``out_dir``; returns a summary of the run."""
+    config = config or TrainConfig()
+    _check_sizes(train_split, val_split, config.batch_size)
+    out = Path(out_dir)
+    ckpt_path = out / "checkpoint.pt"
+    torch.manual_seed(config.seed)
+    model = InverseMLP(settings.n_asperities, settings.n_steps)
+    model.set_input_scaling(train_split.features)
+    opt = torch.optim.AdamW(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
+    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=config.epochs)
+    history: list[dict[str, float]] = []
+    start, best, best_epoch, bad = 0, math.inf, -1, 0
+    if resume:
+        if not ckpt_path.is_file():
+            raise MetainterfaceError(f"--resume: no checkpoint in {out}")
+        state = load_torch(ckpt_path, "checkpoint")
+        if state["config"] != asdict(config):
+            raise MetainterfaceError(
+                f"--resume: {ckpt_path} was made with other settings: {state['config']}"
+            )
+        model.load_state_dict(state["model"])
+        opt.load_state_dict(state["optimizer"])
+        sched.load_state_dict(state["scheduler"])
+        torch.set_rng_state(state["rng"])
+        start, best, best_epoch, bad = (
+            state["epoch"],
+            state["best"],
+            state["best_epoch"],
+            state["bad"],
+        )
+        history = state["history"]
+    elif ckpt_path.exists():
+        raise MetainterfaceError(f"{out} already holds a run; use --resume or another --out")
+    run_info = {
+        "settings": settings.to_dict(),
+        "train": asdict(config),
+        "dataset": dataset_info or {},
+        "provenance": provenance(),
+    }
+    write_text(out / "config.json", json.dumps(run_info, indent=2, default=str) + "\n")
+    schedules = config.schedules
+    n = len(train_split)
+    t_run = time.perf_counter()
+    stopped = False
+    bar = tqdm(
+        range(start, config.epochs),
+        initial=start,
+        total=config.epochs,
+        unit="epoch",
+        disable=not progress,
+        desc="train",
+    )
+    for epoch in bar:
+        t0 = time.perf_counter()
+        kappa, lam = schedules.kappa(epoch), schedules.lam(epoch)
+        model.train()
+        order = torch.randperm(
+            n, generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch)
+        )
+        run_loss, batches = 0.0, 0
+        for lo in range(0, n - config.batch_size + 1, config.batch_size):
+            feats, targets, g_t, h_t = train_split.rows(order[lo : lo + config.batch_size])
+            gamma, h = outputs_to_design(model(feats), settings)
+            pred = curve(gamma, h, settings, smooth=kappa, n_delta=config.physics_steps)
+            loss = physics_loss(pred, targets, LossWeights())
+            if lam > 0:
+                loss = loss + lam * param_loss(gamma, h, g_t, h_t, settings)
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            opt.step()
+            run_loss += float(loss.detach())
+            batches += 1
+        lr = opt.param_groups[0]["lr"]
+        sched.step()
+        val = evaluate_loss(model, val_split, settings)
+        if not math.isfinite(val):
+            raise MetainterfaceError(
+                f"training diverged at epoch {epoch + 1} (validation loss {val})"
+            )
+        history.append(
+            {
+                "epoch": epoch + 1,
+                "train_loss": run_loss / batches,
+                "val_loss": val,
+                "kappa": kappa,
+                "lambda": lam,
+                "lr": lr,
+                "seconds": time.perf_counter() - t0,
+            }
+        )
+        if val < best:
+            best, best_epoch, bad = val, epoch + 1, 0
+            save_model(out / "model.pt", model, {**run_info, "epoch": epoch + 1, "val_loss": val})
+        else:
+            bad += 1
+        save_torch(
+            ckpt_path,
+            {
+                "config": asdict(config),
+                "model": model.state_dict(),
+                "optimizer": opt.state_dict(),
+                "scheduler": sched.state_dict(),
+                "rng": torch.get_rng_state(),
+                "epoch": epoch + 1,
+                "best": best,
+                "best_epoch": best_epoch,
+                "bad": bad,
+                "history": history,
+            },
+        )
+        write_metrics(out / "metrics.csv", history)
+        bar.set_postfix(train=f"{run_loss / batches:.4f}", val=f"{val:.4f}", kappa=f"{kappa:.0f}")
+        if bad >= config.patience:
+            stopped = True
+            break
+    bar.close()
+    return TrainResult(out, len(history), best_epoch, best, stopped, time.perf_counter() - t_run)
+
+
+def write_metrics(path: Path, history: list[dict[str, float]]) -> None:
+    cols = {k: np.array([row[k] for row in history], dtype=np.float64) for k in METRICS}
+    write_columns(path, cols, what="training metrics")
+
+
+def read_metrics(run_dir: str | os.PathLike[str]) -> dict[str, np.ndarray]:
+    """metrics.csv of a run folder as columns."""
+    from metainterface.io.csvfiles import read_columns
+
+    return read_columns(Path(run_dir) / "metrics.csv", METRICS)

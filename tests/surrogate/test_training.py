@@ -1,0 +1,132 @@
+"""The surrogate: architecture, output mapping, schedules, training that learns and resumes."""
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+from metainterface.cli import main
+from metainterface.data import generate_dataset, load_dataset
+from metainterface.errors import MetainterfaceError
+from metainterface.physics import CellSettings
+from metainterface.surrogate.checkpoint import load_model
+from metainterface.surrogate.data import split_of
+from metainterface.surrogate.model import InverseMLP, outputs_to_design
+from metainterface.surrogate.schedules import Schedules
+from metainterface.surrogate.train import TrainConfig, read_metrics, train
+
+S = CellSettings()
+
+
+def test_architecture_matches_table_a1():
+    m = InverseMLP(9, 128)
+    linears = [x for x in m.net if isinstance(x, torch.nn.Linear)]
+    assert [(x.in_features, x.out_features) for x in linears] == [
+        (258, 512),
+        (512, 256),
+        (256, 128),
+        (128, 18),
+    ]
+    assert sum(isinstance(x, torch.nn.Dropout) for x in m.net) == 2
+    assert isinstance(m.net[-1], torch.nn.Sigmoid)
+
+
+def test_output_mapping_sorted_and_bounded():
+    y = torch.rand(64, 18)
+    gamma, h = outputs_to_design(y, S)
+    assert float(gamma.min()) >= 1.8 and float(gamma.max()) <= 4.0
+    assert torch.all(h[:, 0] == 0) and torch.all(h.diff(dim=-1) >= 0)
+    ones = outputs_to_design(torch.ones(1, 18), S)[1]
+    assert float(ones[0, -1]) == pytest.approx(2 * S.delta_max)
+
+
+def test_schedules():
+    s = Schedules(epochs=100, curriculum_epochs=10)
+    assert s.kappa(0) == pytest.approx(1e3) and s.kappa(25) == pytest.approx(1e5)
+    assert s.kappa(99) == pytest.approx(1e5)
+    assert s.kappa(12) == pytest.approx(math.sqrt(1e3 * 1e5), rel=0.1)
+    assert s.lam(0) == 1.0 and s.lam(5) == pytest.approx(0.5) and s.lam(10) == 0.0
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    path = tmp_path_factory.mktemp("ds") / "tiny.npz"
+    generate_dataset(600, 3, S, path, progress=False)
+    ds = load_dataset(path)
+    return path, split_of(ds, "train"), split_of(ds, "val")
+
+
+def test_loss_falls_and_resume_is_bit_for_bit(tiny, tmp_path):
+    _, tr, va = tiny
+    cfg = TrainConfig(epochs=4, batch_size=64, curriculum_epochs=2, physics_steps=32)
+    full = train(tr, va, S, tmp_path / "full", cfg, progress=False)
+    m = read_metrics(full.run_dir)
+    assert m["val_loss"][-1] < m["val_loss"][0] and m["train_loss"][-1] < m["train_loss"][0]
+    # a run stopped after 2 epochs and resumed ends exactly where the full run ends
+    half = TrainConfig(**{**cfg.__dict__})
+    part = tmp_path / "part"
+    train(tr, va, S, part, TrainConfig(**{**cfg.__dict__, "epochs": 4}), progress=False)
+    import shutil
+
+    shutil.rmtree(part)
+    # emulate a kill after epoch 2: train 2 epochs with the same config, then resume
+    from metainterface.surrogate import train as train_mod
+
+    calls = {"n": 0}
+    orig = train_mod.write_metrics
+
+    def killer(path, history):
+        orig(path, history)
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise KeyboardInterrupt
+
+    train_mod.write_metrics = killer
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            train(tr, va, S, part, half, progress=False)
+    finally:
+        train_mod.write_metrics = orig
+    train(tr, va, S, part, half, resume=True, progress=False)
+    a = read_metrics(full.run_dir)
+    b = read_metrics(part)
+    np.testing.assert_array_equal(a["val_loss"], b["val_loss"])
+    ma, _, _ = load_model(full.run_dir / "model.pt")
+    mb, _, _ = load_model(part / "model.pt")
+    for (ka, va_), (_, vb) in zip(ma.state_dict().items(), mb.state_dict().items(), strict=True):
+        assert torch.equal(va_, vb), ka
+
+
+def test_bad_inputs(tiny, tmp_path):
+    path, tr, va = tiny
+    with pytest.raises(MetainterfaceError, match="larger than the training split"):
+        train(tr, va, S, tmp_path / "r", TrainConfig(epochs=1, batch_size=10_000), progress=False)
+    junk = tmp_path / "junk.pt"
+    junk.write_bytes(b"not a model")
+    with pytest.raises(MetainterfaceError, match="not a readable weights file"):
+        load_model(junk)
+    assert (
+        main(
+            [
+                "train",
+                "--dataset",
+                str(path),
+                "--out",
+                str(tmp_path / "r2"),
+                "--batch-size",
+                "100000",
+                "--epochs",
+                "1",
+            ]
+        )
+        == 2
+    )
+
+
+def test_shipped_model_loads():
+    from metainterface.surrogate.checkpoint import default_model_path
+
+    _, settings, config = load_model(default_model_path())
+    assert settings == CellSettings()
+    assert "train" in config and config["epoch"] >= 1
