@@ -1,0 +1,91 @@
+"""Inverse design: speed and quality of the three methods on the built-in targets.
+
+Targets (issue 5): surrogate + refinement <= 0.3 s per target; 50-start multistart <= 3 s per
+target; 100 targets in one batched call <= 10 s; `metainterface design --target saturating`,
+process start included, <= 10 s. Quality: saturating and bilinear <= 1 % after refinement,
+surrogate + refinement at least as good as multistart, realisable targets within 2 %.
+Run: python benchmarks/bench_design.py [--skip-cli] [--batch 100]
+"""
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+import torch
+
+from metainterface.design import builtin_target, design
+from metainterface.design.targets import Target
+from metainterface.physics import CellSettings, sweep
+
+
+def realisable_targets(count: int, seed: int = 7) -> list[Target]:
+    """Curves of random cells (gamma uniform in the bounds, h uniform in [0, Delta_max])."""
+    s = CellSettings()
+    gen = torch.Generator().manual_seed(seed)
+    g = s.gamma_min + (s.gamma_max - s.gamma_min) * torch.rand(
+        count, 9, generator=gen, dtype=torch.float64
+    )
+    h = s.delta_max * torch.rand(count, 9, generator=gen, dtype=torch.float64)
+    sw = sweep(g, h, s, n_delta=256)
+    return [
+        Target(f"random{i}", sw.p_star[i].numpy(), sw.alpha[i].numpy(), sw.stiffness[i].numpy())
+        for i in range(count)
+    ]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--skip-cli", action="store_true")
+    ap.add_argument("--batch", type=int, default=100)
+    args = ap.parse_args()
+    targets = [builtin_target(n) for n in ("saturating", "bilinear", "linear")]
+    design(targets[:1], "surrogate")  # warm-up (imports, model load)
+    print(f"torch {torch.__version__}, {torch.get_num_threads()} threads")
+    print(f"{'target':<12}{'method':<12}{'zero-shot':>10}{'refined':>9}{'s/target':>10}")
+    for method in ("surrogate", "multistart", "hertz"):
+        t0 = time.perf_counter()
+        results = design(targets, method, starts=50)
+        wall = (time.perf_counter() - t0) / len(targets)
+        for r in results:
+            print(
+                f"{r.target.name:<12}{method:<12}{100 * r.initial_error:>9.2f}%"
+                f"{100 * r.error:>8.2f}%{wall:>10.2f}"
+            )
+    batch = realisable_targets(args.batch)
+    t0 = time.perf_counter()
+    res = design(batch, "surrogate")
+    wall = time.perf_counter() - t0
+    errs = np.array([r.error for r in res])
+    print(
+        f"{args.batch} realisable random-cell targets in one call: {wall:.2f} s; error median "
+        f"{100 * np.median(errs):.2f} %, max {100 * errs.max():.2f} %, "
+        f"{int((errs <= 0.02).sum())}/{args.batch} within 2 %"
+    )
+    if not args.skip_cli:
+        with tempfile.TemporaryDirectory() as tmp:
+            t0 = time.perf_counter()
+            subprocess.run(
+                [
+                    sys.executable,
+                    "-m",
+                    "metainterface.cli",
+                    "design",
+                    "--target",
+                    "saturating",
+                    "--out",
+                    tmp,
+                ],
+                check=True,
+                capture_output=True,
+            )
+            print(
+                f"`metainterface design --target saturating` (new process): "
+                f"{time.perf_counter() - t0:.2f} s"
+            )
+
+
+if __name__ == "__main__":
+    main()
