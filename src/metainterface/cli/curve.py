@@ -22,6 +22,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="KAPPA",
         help="softplus steepness kappa_s [1/R] instead of the exact Macaulay bracket",
     )
+    p.add_argument(
+        "--physics",
+        choices=("independent", "interacting"),
+        default="independent",
+        help="forward model: the paper's independent asperities (default) or with their "
+        "elastic interaction through the periodic lattice",
+    )
     p.add_argument("--out", required=True, help="output CSV")
     p.add_argument("--plot", help="also draw alpha(P*) and S*(P*) to this PNG/PDF")
     p.set_defaults(func=run)
@@ -29,10 +36,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from metainterface.io import load_design, write_columns
-    from metainterface.physics.curves import design_sweep
+    from metainterface.physics.forward import design_sweep_for
 
     design = load_design(args.design)
-    sw = design_sweep(design, n_delta=args.steps, smooth=args.smooth)
+    sw = design_sweep_for(design, physics=args.physics, n_delta=args.steps, smooth=args.smooth)
     write_columns(
         args.out,
         {
@@ -45,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
         design=args.design,
         steps=args.steps,
         smooth=args.smooth,
+        physics=args.physics,
         cell=design.settings.to_dict(),
     )
     if args.plot:
@@ -52,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
 
         save_figure(plot_curve(sw, title=args.design), args.plot, command="curve")
     print(
-        f"{args.out}: {args.steps} points, P*_max = {float(sw.p_star[0, -1]):.4g}, "
-        f"alpha_max = {float(sw.alpha[0, -1]):.4g}"
+        f"{args.out}: {args.steps} points ({args.physics}), "
+        f"P*_max = {float(sw.p_star[0, -1]):.4g}, alpha_max = {float(sw.alpha[0, -1]):.4g}"
     )
     return 0

@@ -15,7 +15,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(Polonsky-Keer-Rey, tolerance 1e-11, E* = 1) at K ascending mean pressures up to "
         "the load reached at Delta_max, and compare the contact-area fraction with the "
         "forward model. Writes DIR/bem.csv (p_star,alpha_bem,alpha_model,rel_err,p_max), "
-        "DIR/asperities.csv, DIR/validation.png and DIR/result.json.",
+        "DIR/asperities.csv, DIR/validation.png, DIR/result.json and DIR/models.csv (alpha "
+        "and rel_err of both forward models at the same loads).",
     )
     p.add_argument("design", help="design file (metainterface/design-v1 JSON)")
     p.add_argument(
@@ -52,6 +53,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Polonsky-Keer-Rey tolerance (default 1e-11, the paper's; 1e-9 gives the same "
         "contact areas about 20 %% faster)",
     )
+    p.add_argument(
+        "--physics",
+        choices=("independent", "interacting"),
+        default="independent",
+        help="forward model that sets the loads and alpha_model: the paper's independent "
+        "asperities (default) or with their elastic interaction; both are reported",
+    )
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.set_defaults(func=run)
 
@@ -60,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
     from tqdm.auto import tqdm
 
     from metainterface.errors import MetainterfaceError
-    from metainterface.io import load_design
+    from metainterface.io import load_design, write_columns
     from metainterface.validation import (
         available_cpus,
         model_curve,
@@ -68,12 +76,13 @@ def run(args: argparse.Namespace) -> int:
         require_tamaas,
         write_result,
     )
+    from metainterface.validation.models import models_at
 
     require_tamaas()
     design = load_design(args.design)
     loads: object = args.loads
     if args.p_max is not None:
-        p_top = model_curve(design).p_star_max
+        p_top = model_curve(design, args.physics).p_star_max
         if args.p_max > p_top * (1 + 1e-12):
             raise MetainterfaceError(
                 f"--p-max {args.p_max:g} is beyond what the design reaches at Delta_max "
@@ -81,12 +90,30 @@ def run(args: argparse.Namespace) -> int:
             )
         loads = [args.p_max * i / args.loads for i in range(1, args.loads + 1)]
     plan = plan_validation(
-        design, args.grid, loads, name=args.design, tolerance=args.tolerance
+        design,
+        args.grid,
+        loads,
+        name=args.design,
+        tolerance=args.tolerance,
+        physics=args.physics,
     )  # checks all input
     jobs = args.jobs or min(available_cpus(), args.loads)
     with tqdm(total=args.loads, desc="BEM loads", unit="load") as bar:
         result = plan.solve(jobs, progress=bar.update)
     write_result(result, args.out, command="validate", jobs=jobs)
+    both = models_at(design, result.p_star)
+    rel = {name: result.alpha_bem / alpha - 1.0 for name, alpha in both.items()}
+    columns = {"p_star": result.p_star, "alpha_bem": result.alpha_bem}
+    columns |= {f"alpha_{name}": alpha for name, alpha in both.items()}
+    columns |= {f"rel_err_{name}": r for name, r in rel.items()}
+    write_columns(
+        f"{args.out}/models.csv",
+        columns,
+        command="validate",
+        design=args.design,
+        grid=result.grid,
+        loads_from=args.physics,
+    )
     k = len(result.p_star)
     print(
         f"{args.out}: {k} loads on {result.grid}x{result.grid}, "
@@ -97,5 +124,12 @@ def run(args: argparse.Namespace) -> int:
         f"largest relative error over the upper half of the loads "
         f"(P* >= {result.p_star[result.upper_half][0]:.4g}): "
         f"{100 * result.max_rel_err_upper:.2f} %"
+    )
+    upper = result.upper_half
+    print(
+        "  by model (loads from the "
+        + args.physics
+        + " model): "
+        + ", ".join(f"{name} {100 * abs(r[upper]).max():.2f} %" for name, r in rel.items())
     )
     return 0

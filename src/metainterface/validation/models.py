@@ -2,9 +2,10 @@
 
 A model maps a Design to its response along a Delta sweep (a ``ModelCurve``); the validator
 interpolates that curve at the BEM loads. ``independent`` is the paper's superposition of
-non-interacting Sneddon asperities (``metainterface.physics``). A second model (e.g. an
-interaction-aware one) is plugged in with ``register_model("name", fn)`` and selected with
-``validate_design(..., physics="name")``; nothing else in the validation code changes.
+non-interacting Sneddon asperities (``metainterface.physics``), ``interacting`` the same
+with their elastic interaction (``physics.interaction``). Further models are plugged in with
+``register_model("name", fn)`` and selected with ``validate_design(..., physics="name")``;
+nothing else in the validation code changes.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import torch
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.curves import anchor, delta_grid, interp, sweep
+from metainterface.physics.forward import PHYSICS, alpha_at_loads, asperity_sweep
 from metainterface.physics.sneddon import area
 
 #: Delta samples of the dense sweep that BEM loads are interpolated on.
@@ -70,7 +72,20 @@ def independent_asperities(design: Design, n_delta: int = N_DELTA) -> ModelCurve
     )
 
 
-MODELS: dict[str, ModelFunction] = {"independent": independent_asperities}
+def interacting_asperities(design: Design, n_delta: int = N_DELTA) -> ModelCurve:
+    """The same asperities with their elastic interaction (``physics.interaction``, issue 9)."""
+    gamma, h = design.tensors(torch.float64)
+    delta = delta_grid(design.settings, n_delta)
+    sw, per = asperity_sweep(gamma, h, design.settings, physics="interacting", delta=delta)
+    return ModelCurve(
+        p_star=sw.p_star[0].numpy(), alpha=sw.alpha[0].numpy(), asperity_alpha=per[0].numpy()
+    )
+
+
+MODELS: dict[str, ModelFunction] = {
+    "independent": independent_asperities,
+    "interacting": interacting_asperities,
+}
 
 
 def register_model(name: str, fn: ModelFunction) -> None:
@@ -90,3 +105,18 @@ def model_curve(design: Design, physics: str = "independent") -> ModelCurve:
     if not (curve.p_star.size >= 2 and curve.p_star_max > 0):
         raise MetainterfaceError(f"model {physics!r} gives no load up to Delta_max")
     return curve
+
+
+def models_at(design: Design, p_star: np.ndarray) -> dict[str, np.ndarray]:
+    """alpha (K,) of ``design`` at the loads ``p_star`` (K,) under every built-in model.
+
+    For reporting several models against one BEM path: the loads come from one model's
+    P*_max, which the other may reach a little past or short of Delta_max, so each model's
+    exact sweep is run as far as the loads need (``forward.alpha_at_loads``).
+    """
+    gamma, h = design.tensors(torch.float64)
+    loads = torch.as_tensor(np.asarray(p_star, dtype=np.float64))[None]
+    return {
+        name: alpha_at_loads(gamma, h, design.settings, loads, physics=name)[0].numpy()
+        for name in PHYSICS
+    }
