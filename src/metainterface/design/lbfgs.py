@@ -69,8 +69,8 @@ def minimize(
     max_iter: int = 100,
     history: int = 10,
     tol_grad: float = 1e-7,
-    tol_change: float = 1e-7,
-    tol_loss: float = 1e-9,
+    tol_change: float = 1e-10,
+    tol_loss: float = 1e-12,
     max_ls: int = 8,
 ) -> LbfgsResult:
     """Minimise ``fun`` (B, D) -> (B,) row by row; returns the final points and losses.
