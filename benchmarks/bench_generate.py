@@ -6,7 +6,8 @@ Target (issue 3) on the 2-core dev machine: <= 3 s wall and <= 400 MB peak RSS. 
 time is that of ``generate_dataset`` (sampling, curves, writing, fsync); the import time of
 the package (torch, scipy) is printed separately. The peak RSS (ru_maxrss) covers the whole
 process, imports included. The process CPU time is printed too: on a shared machine it says
-more than the wall time (with --threads 1 it is what the run takes alone on one core).
+more than the wall time. --threads T sets torch's thread count, which generate_dataset turns
+into min(4, T) curve workers of one thread each.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=100_000)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", help="folder for the file (default: a temporary one)")
-    parser.add_argument("--threads", type=int, help="torch intra-op threads (default: torch's)")
+    parser.add_argument("--threads", type=int, help="torch threads (default: torch's own)")
     args = parser.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
@@ -52,7 +53,7 @@ def main() -> None:
     print(f"import metainterface: {t_import:.2f} s, peak RSS after import {mb_before:.0f} MB")
     print(
         f"generate {args.samples} samples: {wall:.2f} s wall, {cpu:.2f} s CPU "
-        f"({torch.get_num_threads()} torch threads), {args.samples / wall:,.0f} samples/s, "
+        f"({min(4, torch.get_num_threads())} curve workers), {args.samples / wall:,.0f} samples/s, "
         f"file {size:.0f} MiB, peak RSS {_peak_mb():.0f} MB"
     )
 

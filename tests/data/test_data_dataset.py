@@ -70,10 +70,13 @@ def test_split_is_shuffled_within_categories(dataset):
     assert not np.all(lhs[: lhs.size * 8 // 10] == "train")
 
 
-@pytest.mark.parametrize("chunk", [60, 10_000])  # the fixture used chunk 250, block 97
-def test_same_seed_same_arrays_whatever_the_chunk(tmp_path, settings, dataset, chunk):
+# the fixture used chunk 250, block 97 and the default workers
+@pytest.mark.parametrize(("chunk", "workers"), [(60, 1), (10_000, 3)])
+def test_same_seed_same_arrays_whatever_the_chunk(tmp_path, settings, dataset, chunk, workers):
     path = tmp_path / "again.npz"
-    generate_dataset(SAMPLES, SEED, settings, path, progress=False, chunk=chunk, block=97)
+    generate_dataset(
+        SAMPLES, SEED, settings, path, progress=False, chunk=chunk, block=97, workers=workers
+    )
     again = load_dataset(path)
     for name in ROW_ARRAYS:
         np.testing.assert_array_equal(getattr(again, name), getattr(dataset, name), err_msg=name)

@@ -35,9 +35,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--plot", metavar="FIG.png", help="also draw example curves per category")
     p.add_argument(
         "--chunk",
-        default="8192",
         metavar="K",
-        help="samples processed at once (memory only; results do not depend on it)",
+        help="samples processed at once (default 4096; memory only, results do not depend on it)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
@@ -62,6 +61,7 @@ def _float(option: str, text: str) -> float:
 
 def run(args: argparse.Namespace) -> int:
     from metainterface.data import CATEGORIES, FIGURE_ORDER, generate_dataset
+    from metainterface.data.dataset import DEFAULT_CHUNK
     from metainterface.physics import CellSettings
 
     samples = _int("--samples", args.samples)
@@ -70,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     seed = _int("--seed", args.seed)
     if seed < 0:
         raise MetainterfaceError(f"--seed must be >= 0, got {seed}")
-    chunk = _int("--chunk", args.chunk)
+    chunk = DEFAULT_CHUNK if args.chunk is None else _int("--chunk", args.chunk)
     if chunk <= 0:
         raise MetainterfaceError(f"--chunk must be > 0, got {chunk}")
     settings = CellSettings(
