@@ -13,8 +13,8 @@ normalised form of appendix A.1. Arrays of the file:
 Reproducibility: category c's samples come in blocks of at most ``block`` rows; block b is
 drawn by a generator seeded with ``SeedSequence(seed, spawn_key=(c, b))`` (the split with
 spawn key (6,)). The blocks depend only on (samples, block), not on the processing chunk, so
-a seed gives the same arrays whatever ``chunk`` is. Memory stays flat in S: each chunk is
-sampled, computed and written straight to its place in the file (``NpzStreamWriter``).
+a seed gives the same arrays whatever ``chunk`` and ``workers`` are. Memory stays flat in S: each
+chunk is sampled, computed and written straight to its place in the file (``NpzStreamWriter``).
 """
 
 from __future__ import annotations
