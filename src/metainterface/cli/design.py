@@ -54,6 +54,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--model", help="surrogate model file (default: the shipped one)")
     p.add_argument(
+        "--physics",
+        choices=("independent", "interacting"),
+        default="independent",
+        help="forward model to refine and measure with (default: the paper's independent one)",
+    )
+    p.add_argument(
         "--max-pressure",
         help="peak contact pressure limit: p/E* (number) or a stress with --modulus",
     )
@@ -134,6 +140,7 @@ def run(args: argparse.Namespace) -> int:
                 starts=args.starts,
                 seed=args.seed,
                 extra_loss=extra,
+                physics=args.physics,
             )
         )
     from metainterface.io.report import write_design_outputs

@@ -30,6 +30,7 @@ from metainterface.design.targets import Target, target_features
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import alpha_at
+from metainterface.physics.forward import DEFAULT_PHYSICS, check_physics
 
 METHODS = ("surrogate", "multistart", "hertz")
 
@@ -46,6 +47,7 @@ class DesignResult:
     seconds: float
     initial_error: float
     settings: CellSettings
+    physics: str = DEFAULT_PHYSICS
 
 
 def _starts(
@@ -87,8 +89,14 @@ def design(
     seed: int = 0,
     refine_settings: RefineSettings | None = None,
     extra_loss: Callable[[Tensor, Tensor], Tensor] | None = None,
+    physics: str = DEFAULT_PHYSICS,
 ) -> list[DesignResult]:
-    """Design one cell per target with ``method``; returns one result per target."""
+    """Design one cell per target with ``method``; returns one result per target.
+
+    ``physics`` is the forward model the refinement optimises and the error is measured with
+    ("independent", the paper's, or "interacting"); the surrogate was trained on the former.
+    """
+    check_physics(physics)
     if method not in METHODS:
         raise MetainterfaceError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     if starts < 1:
@@ -124,11 +132,11 @@ def design(
     # the starts as the refinement sees them (sorted, anchored, inside the bounds)
     raw = from_design(gamma0, h0, settings, hertz)
     gamma_i, h_i = to_design(raw, settings, hertz)
-    err0 = relative_error(gamma_i, h_i, settings, rows)
+    err0 = relative_error(gamma_i, h_i, settings, rows, physics)
     if refine_designs:
-        raw = refine(raw, settings, rows, refine_settings, hertz, extra_loss)
+        raw = refine(raw, settings, rows, refine_settings, hertz, extra_loss, physics)
     gamma, h = to_design(raw.detach(), settings, hertz)
-    err = relative_error(gamma, h, settings, rows)
+    err = relative_error(gamma, h, settings, rows, physics)
     best = err.view(len(targets), per_target).argmin(-1) + torch.arange(len(targets)) * per_target
     seconds = (time.perf_counter() - t0) / len(targets)
     return [

@@ -13,6 +13,7 @@ iterations (5 x 5 x 20, learning rate 0.5, strong Wolfe, by default).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +24,7 @@ from torch.nn import functional as nnf
 from metainterface.design import lbfgs
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import alpha_at
+from metainterface.physics.forward import DEFAULT_PHYSICS, sweep_for
 
 DTYPE = torch.float64
 
@@ -99,19 +101,28 @@ def masked_loss(
     target: TargetGrid,
     smooth: float | None,
     undershoot: float = 0.1,
+    physics: str = DEFAULT_PHYSICS,
 ) -> Tensor:
     """The weighted MSE of appendix C per row (B,), relative to mean(alpha_t^2)."""
-    alpha, p_max = alpha_at(gamma, h, settings, target.p, smooth=smooth)
+    alpha, p_max = alpha_at(
+        gamma, h, settings, target.p, smooth=smooth, sweep_fn=sweep_for(physics)
+    )
     w = torch.where(target.p <= p_max[:, None], 1.0, undershoot)
     err = (w * (alpha - target.alpha) ** 2).sum(-1) / w.sum(-1)
     return err / (target.alpha**2).mean(-1)
 
 
-def relative_error(gamma: Tensor, h: Tensor, settings: CellSettings, target: TargetGrid) -> Tensor:
+def relative_error(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    target: TargetGrid,
+    physics: str = DEFAULT_PHYSICS,
+) -> Tensor:
     """||alpha_design - alpha_target||_2 / ||alpha_target||_2 on the target's grid (exact
     physics, the design's curve held at its last value where it stops short). (B,)."""
     with torch.no_grad():
-        alpha, _ = alpha_at(gamma, h, settings, target.p)
+        alpha, _ = alpha_at(gamma, h, settings, target.p, sweep_fn=sweep_for(physics))
         return torch.linalg.vector_norm(alpha - target.alpha, dim=-1) / torch.linalg.vector_norm(
             target.alpha, dim=-1
         )
@@ -121,9 +132,10 @@ def refine(
     raw: Tensor,
     settings: CellSettings,
     target: TargetGrid,
-    rs: RefineSettings = RefineSettings(),
+    rs: RefineSettings | None = None,
     hertz: bool = False,
-    extra_loss=None,
+    extra_loss: Callable[[Tensor, Tensor], Tensor] | None = None,
+    physics: str = DEFAULT_PHYSICS,
 ) -> Tensor:
     """Run the stages on a batch of unbounded parameters (B, D); each row is its own problem
     against the matching row of ``target``. ``extra_loss(gamma, h) -> (B,)`` is added if given
@@ -134,7 +146,7 @@ def refine(
 
         def fun(z: Tensor, kappa: float = float(kappa)) -> Tensor:
             gamma, h = to_design(z, settings, hertz)
-            loss = masked_loss(gamma, h, settings, target, kappa, rs.undershoot_weight)
+            loss = masked_loss(gamma, h, settings, target, kappa, rs.undershoot_weight, physics)
             return loss if extra_loss is None else loss + extra_loss(gamma, h)
 
         x = lbfgs.minimize(fun, x, lr=rs.lr, max_iter=rs.steps_per_stage * rs.iterations).x

@@ -9,7 +9,7 @@ from typing import Any
 from metainterface.io.csvfiles import write_columns
 from metainterface.io.design_file import save_design
 from metainterface.physics.cell import Design
-from metainterface.physics.curves import design_sweep
+from metainterface.physics.forward import design_sweep_for
 
 
 def write_design_outputs(
@@ -32,6 +32,7 @@ def write_design_outputs(
             **t.meta,
         },
         "method": result.method,
+        "physics": result.physics,
         "relative_error": result.error,
         "zero_shot_error": result.initial_error,
         "seconds": result.seconds,
@@ -59,7 +60,7 @@ def write_design_outputs(
         )
     folder.mkdir(parents=True, exist_ok=True)
     write_columns(folder / "target.csv", {"p_star": t.p_star, "alpha": t.alpha}, target=t.name)
-    sw = design_sweep(d, n_delta=256)
+    sw = design_sweep_for(d, physics=result.physics, n_delta=256)
     write_columns(
         folder / "curve.csv",
         {

@@ -9,6 +9,7 @@ alpha = A_tot / A_nom, S* = dP*/dalpha.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -212,13 +213,15 @@ def alpha_at(
     *,
     smooth: float | None = None,
     n_delta: int | None = None,
+    sweep_fn: Callable[..., Sweep] | None = None,
 ) -> tuple[Tensor, Tensor]:
     """alpha of (B, N) designs at given pressures p_star (B, M), and P*_max (B,).
 
     Beyond a design's P*_max its alpha is held at the last value (the convention of the
-    relative curve error and of the refinement's undershoot term).
+    relative curve error and of the refinement's undershoot term). ``sweep_fn`` picks the
+    forward model (default: the independent one, :func:`sweep`).
     """
-    sw = sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta)
+    sw = (sweep_fn or sweep)(gamma, h, settings, smooth=smooth, n_delta=n_delta)
     zero = torch.zeros_like(sw.p_star[:, :1])
     p = torch.cat([zero, sw.p_star], dim=-1)
     return interp(p_star, p, torch.cat([zero, sw.alpha], dim=-1)), p[:, -1]
