@@ -8,7 +8,7 @@ import numpy as np
 import torch
 from matplotlib.figure import Figure
 
-from metainterface.physics.curves import sweep
+from metainterface.physics.forward import sweep_for
 from metainterface.plots.common import new_figure
 
 COLORS = {"surrogate": "C0", "multistart": "C2", "hertz": "C1"}
@@ -17,7 +17,7 @@ COLORS = {"surrogate": "C0", "multistart": "C2", "hertz": "C1"}
 def _curve(result):
     g = torch.as_tensor(result.gamma, dtype=torch.float64)[None]
     h = torch.as_tensor(result.h, dtype=torch.float64)[None]
-    sw = sweep(g, h, result.settings, n_delta=512)
+    sw = sweep_for(getattr(result, "physics", "independent"))(g, h, result.settings, n_delta=512)
     return sw.p_star[0].numpy(), sw.alpha[0].numpy(), sw.stiffness[0].numpy()
 
 
