@@ -98,3 +98,12 @@ def test_design_cli_bad_input(tmp_path, capsys):
     assert main(["design", "--target-csv", str(bad), "--out", str(out)]) == 2
     assert "row 3" in capsys.readouterr().err and not out.exists()
     assert main(["design", "--target", "nope", "--out", str(out)]) == 2
+
+
+def test_hedge_starts_are_refined_with_the_zero_shot_one():
+    t = [builtin_target("bilinear")]
+    pure = design(t, "surrogate", refine_settings=FAST)[0]
+    hedged = design(t, "surrogate", hedge=3, seed=2, refine_settings=FAST)[0]
+    assert pure.start == 0 and 0 <= hedged.start <= 3
+    assert hedged.initial_error == pytest.approx(pure.initial_error)  # the zero-shot row's
+    assert hedged.error < 0.05

@@ -33,6 +33,11 @@ def write_design_outputs(
         },
         "method": result.method,
         "physics": result.physics,
+        "winning_start": (
+            "zero-shot"
+            if result.method == "surrogate" and result.start == 0
+            else f"random start {result.start}"
+        ),
         "relative_error": result.error,
         "zero_shot_error": result.initial_error,
         "seconds": result.seconds,
