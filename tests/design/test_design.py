@@ -107,3 +107,43 @@ def test_hedge_starts_are_refined_with_the_zero_shot_one():
     assert pure.start == 0 and 0 <= hedged.start <= 3
     assert hedged.initial_error == pytest.approx(pure.initial_error)  # the zero-shot row's
     assert hedged.error < 0.05
+
+
+def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, capsys):
+    # friction grows with load, sub-linearly; tau = 0.25 MPa, E* = 2 MPa, A = 4 cm^2
+    loads = np.linspace(0.0, 1.2, 12)  # N; P* = F / (A E*) up to 1.5e-3
+    friction = 0.25e6 * 4e-4 * 0.06 * (loads / loads[-1]) ** 0.7  # alpha up to 0.06
+    csv = tmp_path / "law.csv"
+    csv.write_text(
+        "normal_force,friction_force\n"
+        + "\n".join(f"{n},{f}" for n, f in zip(loads, friction, strict=True))
+    )
+    out = tmp_path / "out"
+    args = [
+        "design",
+        "--friction-csv",
+        str(csv),
+        "--shear-strength",
+        "0.25MPa",
+        "--modulus",
+        "2MPa",
+        "--radius",
+        "0.5mm",
+        "--area",
+        "4cm2",
+        "--out",
+        str(out),
+        "--refine",
+        "none",
+        "--max-pressure",
+        "0.5",
+    ]
+    assert main(args) == 0, capsys.readouterr().err
+    data = json.loads((out / "law" / "design.json").read_text())
+    assert data["physical"]["radius_m"] == pytest.approx(5e-4)
+    assert data["physical"]["n_cells"] == pytest.approx(4e-4 / data["physical"]["cell_area_m2"])
+    assert data["pressure_check"]["limit_p_over_e_star"] == pytest.approx(0.5)
+    assert "friction" in data["target"]
+    np.testing.assert_allclose(data["target"]["alpha"][-1], 0.06, rtol=1e-9)
+    assert main([*args[:-4], "--modulus", "2mm"]) == 2  # a length is not a stress
+    assert "modulus" in capsys.readouterr().err
