@@ -169,6 +169,14 @@ def run(args: argparse.Namespace) -> int:
                 out / t.name / "compare.png",
                 command="design --compare",
             )
+    if limit is not None:
+        from metainterface.io.report import pressure_check
+        from metainterface.physics.cell import Design
+
+        for res in all_results:
+            for r in res:
+                d = Design(gamma=r.gamma, h=r.h, settings=r.settings)
+                print(f"{r.target.name} ({r.method}): {pressure_check(d, limit, e_star).summary()}")
     print(f"{'target':<14}{'method':<12}{'zero-shot':>10}{'error':>9}{'seconds':>9}  output")
     for name, method, e0, e, sec, folder in rows:
         print(f"{name:<14}{method:<12}{100 * e0:>9.2f}%{100 * e:>8.2f}%{sec:>9.2f}  {folder}")

@@ -12,6 +12,16 @@ from metainterface.physics.cell import Design
 from metainterface.physics.forward import design_sweep_for
 
 
+def pressure_check(design: Design, limit: float, e_star: float | None = None):
+    """Peak pressures of a design against a limit given as p/E* (reported in Pa with E*)."""
+    from metainterface.physics.limits import check_pressure
+
+    # check_pressure takes a stress [Pa] when it is given the modulus
+    if e_star:
+        return check_pressure(design, limit * e_star, e_star=e_star)
+    return check_pressure(design, limit)
+
+
 def write_design_outputs(
     folder: Path,
     result: Any,
@@ -45,9 +55,7 @@ def write_design_outputs(
     if args is not None:
         extra["command"] = {k: v for k, v in vars(args).items() if k != "func"}
     if pressure_limit is not None:
-        from metainterface.physics.limits import check_pressure
-
-        extra["pressure_check"] = check_pressure(d, pressure_limit, e_star=e_star).to_dict()
+        extra["pressure_check"] = pressure_check(d, pressure_limit, e_star).to_dict()
     if args is not None and args.radius and args.modulus:
         from metainterface.io.physical import physical_block
         from metainterface.io.units import parse_area, parse_force, parse_length, parse_pressure
