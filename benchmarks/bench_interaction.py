@@ -5,21 +5,24 @@ Cells: 20 random ones (numpy seed 2026; gamma uniform in [1.8, 4], h uniform in
 Loads: 8, uniform up to P*_max of the paper's model (P* at Delta_max), as `validate` does;
 BEM by ``metainterface.validation`` (Polonsky-Keer-Rey, tolerance 1e-11). Error of a model:
 the largest |alpha_bem / alpha_model - 1| over the upper half of the loads, both models
-compared at the BEM's P*. "tip shift only" is the interacting model without the neighbours'
-curvature term (interaction(...).curvature set to 0), shown for reference.
+compared at the BEM's P*. "interacting" is the default model (tip shift only), "+ curvature"
+the same with the neighbours' curvature term (``curvature=True``), shown for reference.
 
 Targets: interacting <= 2 % on every cell; uniform cells no worse than independent; forward
 cost of the interacting model <= 3x the independent one.
 
 BEM results are cached per grid in benchmarks/results/interaction_bem_<M>.json, so an
 interrupted run resumes; the table is printed and, with --out, written as Markdown.
-Run: python benchmarks/bench_interaction.py [--grid 768] [--jobs 1] [--out FILE.md]
+--convergence refines the BEM grid (384, 768, 1536) on the uniform cells (~15 minutes) to
+show what part of the error is the BEM's own.
+Run: python benchmarks/bench_interaction.py [--grid 768] [--jobs 1] [--convergence] [--out FILE.md]
      python benchmarks/bench_interaction.py --timing-only
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import time
@@ -29,12 +32,13 @@ import numpy as np
 import torch
 
 from metainterface.physics import CellSettings, Design, interp, sweep
-from metainterface.physics.forward import alpha_at_loads
-from metainterface.physics.interaction import Interaction, interaction, sweep_interacting
+from metainterface.physics.forward import alpha_at, alpha_at_loads
+from metainterface.physics.interaction import load_area_interacting, sweep_interacting
 
 RESULTS = Path(__file__).parent / "results"
 N_LOADS = 8
 SEED = 2026
+GRIDS = (384, 768, 1536)
 
 
 def cells(settings: CellSettings) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -75,12 +79,18 @@ def bem(name, g, h, settings, grid, jobs, cache):
     return entry
 
 
-def tip_shift_only(g, h, settings, loads):
-    kern = interaction(settings)
-    kern = Interaction(kern.shift, kern.curvature * 0.0)
-    delta = torch.linspace(0, 2 * settings.delta_max, 4097, dtype=torch.float64)
-    sw = sweep_interacting(g, h, settings, delta=delta, kernel=kern)
+def with_curvature(g, h, settings, loads):
+    delta = torch.linspace(0, 2 * settings.delta_max, 16385, dtype=torch.float64)
+    sw = sweep_interacting(g, h, settings, delta=delta, curvature=True)
     return interp(loads, sw.p_star, sw.alpha)
+
+
+def alpha_at_curvature(g, h, settings, p):
+    """``forward.alpha_at(..., physics="interacting")`` with the curvature term."""
+    _, p_sw, alpha = load_area_interacting(g, h, settings, curvature=True)
+    zero = torch.zeros_like(p_sw[:, :1])
+    p_sw = torch.cat([zero, p_sw], dim=-1)
+    return interp(p, p_sw, torch.cat([zero, alpha], dim=-1)), p_sw[:, -1]
 
 
 def accuracy(args, settings) -> list[str]:
@@ -88,7 +98,7 @@ def accuracy(args, settings) -> list[str]:
     cache = json.loads(cache_file.read_text()) if cache_file.exists() else {}
     rows = []
     header = (
-        "| cell | gamma | h spread | independent | interacting | tip shift only | "
+        "| cell | gamma | h spread | independent | interacting | + curvature | "
         "independent, all loads | interacting, all loads |"
     )
     lines = [header, "|" + "---|" * 8]
@@ -108,20 +118,21 @@ def accuracy(args, settings) -> list[str]:
         ht = torch.tensor(h, dtype=torch.float64)[None]
         loads = torch.tensor(e["p_star"], dtype=torch.float64)[None]
         a_bem = np.array(e["alpha_bem"])
-        a_ind = np.array(e["alpha_independent"])
-        a_int = alpha_at_loads(gt, ht, settings, loads, physics="interacting", n_delta=4097)[
-            0
-        ].numpy()
-        a_tip = tip_shift_only(gt, ht, settings, loads)[0].numpy()
+        # both models evaluated the same way, at the BEM's loads (past Delta_max if needed)
+        a_ind, a_int = (
+            alpha_at_loads(gt, ht, settings, loads, physics=ph, n_delta=8193)[0].numpy()
+            for ph in ("independent", "interacting")
+        )
+        a_cur = with_curvature(gt, ht, settings, loads)[0].numpy()
         up = slice(N_LOADS // 2, None)
         err = {
-            k: np.abs(a_bem / a - 1) for k, a in (("ind", a_ind), ("int", a_int), ("tip", a_tip))
+            k: np.abs(a_bem / a - 1) for k, a in (("ind", a_ind), ("int", a_int), ("cur", a_cur))
         }
         row = {
             "name": name,
             "ind": float(err["ind"][up].max()),
             "int": float(err["int"][up].max()),
-            "tip": float(err["tip"][up].max()),
+            "cur": float(err["cur"][up].max()),
             "ind_all": float(err["ind"].max()),
             "int_all": float(err["int"].max()),
             "signed_int": (a_bem / a_int - 1).tolist(),
@@ -129,7 +140,7 @@ def accuracy(args, settings) -> list[str]:
         rows.append(row)
         line = (
             f"| {name} | {g.min():.2f}-{g.max():.2f} | {1e3 * (h.max() - h.min()):.1f}e-3 | "
-            f"{100 * row['ind']:.2f} % | {100 * row['int']:.2f} % | {100 * row['tip']:.2f} % | "
+            f"{100 * row['ind']:.2f} % | {100 * row['int']:.2f} % | {100 * row['cur']:.2f} % | "
             f"{100 * row['ind_all']:.2f} % | {100 * row['int_all']:.2f} % |"
         )
         lines.append(line)
@@ -155,58 +166,122 @@ def accuracy(args, settings) -> list[str]:
             f"alpha_bem / alpha_interacting - 1 over the upper half {100 * bias:+.2f} %"
         )
     if uni:
-        worse = [r["name"] for r in uni if r["int"] > r["ind"] + 1e-12]
-        summary.append(
-            "uniform cells: interacting no worse than independent: "
-            + ("yes" if not worse else f"no, worse on {', '.join(worse)}")
-        )
+        for key, label in (("int", "interacting"), ("cur", "+ curvature")):
+            worse = [r["name"] for r in uni if r[key] > r["ind"] + 1e-12]
+            summary.append(
+                f"uniform cells: {label} no worse than independent: "
+                + ("yes" if not worse else f"no, worse on {', '.join(worse)}")
+            )
     for s in summary:
         print(s)
     return lines + summary
 
 
+def convergence(settings: CellSettings, jobs: int) -> list[str]:
+    """BEM grid refinement on the uniform cells: the same loads and error as the main table
+    (upper half of 8 loads), on 384, 768 and 1536 grids. For identical asperities the
+    interacting model is the paper's, so what changes with the grid is the BEM's own error."""
+    from metainterface.validation import plan_validation
+
+    lines = [
+        "",
+        "BEM grid refinement on the uniform cells (independent = interacting there): "
+        "max |alpha_bem / alpha_model - 1| over the upper half of the 8 loads, and in "
+        "brackets the signed values at loads 5/8 ... 8/8:",
+        "",
+        "| cell | model | " + " | ".join(f"{m} x {m}" for m in GRIDS) + " |",
+        "|---|---|" + "---|" * len(GRIDS),
+    ]
+    print("\n".join(lines), flush=True)
+    for g0 in (1.8, 2.0, 4.0):
+        g, h = np.full(9, g0), np.zeros(9)
+        design = Design(gamma=g, h=h, settings=settings)
+        gt, ht = torch.tensor(g)[None], torch.tensor(h)[None]
+        p_max = float(sweep(gt, ht, settings).p_star[0, -1])
+        loads = p_max * np.arange(5, 9) / N_LOADS
+        lt = torch.tensor(loads)[None]
+        a_ind = alpha_at_loads(gt, ht, settings, lt, n_delta=8193)[0].numpy()
+        a_cur = with_curvature(gt, ht, settings, lt)[0].numpy()
+        bem = {m: plan_validation(design, m, loads).solve(jobs).alpha_bem for m in GRIDS}
+        for label, a in (("independent, interacting", a_ind), ("+ curvature", a_cur)):
+            cells = []
+            for m in GRIDS:
+                e = bem[m] / a - 1
+                signed = ", ".join(f"{100 * x:+.2f}" for x in e)
+                cells.append(f"{100 * np.abs(e).max():.2f} % ({signed})")
+            lines.append(f"| uniform {g0:g} | {label} | " + " | ".join(cells) + " |")
+            print(lines[-1], flush=True)
+    return lines
+
+
 def timing(settings: CellSettings, threads: int) -> list[str]:
-    """Forward cost of both models in three regimes: best of interleaved repeats."""
+    """Forward cost of the models in four regimes: best of interleaved repeats."""
     torch.set_num_threads(threads)
     lines = [
         "",
-        f"forward cost, sweep of K = 128 Delta samples (torch {torch.__version__}, "
-        f"{threads} thread(s), load average {os.getloadavg()[0]:.1f}; best of interleaved "
-        f"repeats):",
+        f"forward cost, K = 128 Delta samples (torch {torch.__version__}, {threads} "
+        f"thread(s), load average {os.getloadavg()[0]:.1f}; best of interleaved repeats; "
+        "ratios to independent):",
         "",
-        "| case | independent | interacting | ratio |",
+        "| case | independent | interacting | + curvature |",
         "|---|---|---|---|",
     ]
     rng = np.random.default_rng(0)
+    p_grid = torch.linspace(0.0, 0.002, 64, dtype=torch.float64)
+    models = {
+        "sweep": (
+            sweep,
+            sweep_interacting,
+            functools.partial(sweep_interacting, curvature=True),
+        ),
+        "alpha_at": (
+            functools.partial(alpha_at, physics="independent"),
+            functools.partial(alpha_at, physics="interacting"),
+            alpha_at_curvature,
+        ),
+    }
     cases = [
-        ("1 design, float64, forward (curve)", 1, torch.float64, False, 60),
-        ("64 designs, float64, forward + backward (design)", 64, torch.float64, True, 15),
-        ("1024 designs, float32, forward (batch)", 1024, torch.float32, False, 8),
+        ("sweep, 1 design, float64, forward (curve)", "sweep", 1, torch.float64, False, 60),
+        ("sweep, 64 designs, float64, fwd + bwd", "sweep", 64, torch.float64, True, 15),
+        ("sweep, 1024 designs, float32, forward", "sweep", 1024, torch.float32, False, 6),
+        (
+            "alpha_at, 64 designs, float64, fwd + bwd (refine)",
+            "alpha_at",
+            64,
+            torch.float64,
+            True,
+            15,
+        ),
     ]
-    for label, b, dtype, grad, reps in cases:
+    for label, kind, b, dtype, grad, reps in cases:
         g0 = torch.as_tensor(rng.uniform(1.8, 4.0, (b, 9)), dtype=dtype)
         h0 = torch.as_tensor(rng.uniform(0.0, settings.delta_max, (b, 9)), dtype=dtype)
+        p = p_grid.to(dtype)[None].expand(b, -1)
 
-        def run(fn, g0=g0, h0=h0, grad=grad) -> float:
+        def run(fn, g0=g0, h0=h0, p=p, grad=grad, kind=kind) -> float:
             t0 = time.perf_counter()
-            if grad:
-                g, h = g0.clone().requires_grad_(), h0.clone().requires_grad_()
-                sw = fn(g, h, settings)
-                (sw.alpha.sum() + sw.stiffness.sum() + sw.p_star.sum()).backward()
-            else:
-                with torch.inference_mode():
-                    fn(g0, h0, settings)
+            with torch.inference_mode(not grad):
+                g, h = g0.clone().requires_grad_(grad), h0.clone().requires_grad_(grad)
+                if kind == "sweep":
+                    sw = fn(g, h, settings)
+                    out = sw.alpha.sum() + sw.stiffness.sum() + sw.p_star.sum()
+                else:
+                    out = fn(g, h, settings, p)[0].square().sum()
+                if grad:
+                    out.backward()
             return time.perf_counter() - t0
 
-        best = {sweep: float("inf"), sweep_interacting: float("inf")}
-        for fn in best:
+        fns = models[kind]
+        best = [float("inf")] * len(fns)
+        for fn in fns:
             run(fn)  # warm-up (and the kernel's one-off Ewald sums)
         for _ in range(reps):
-            for fn in best:
-                best[fn] = min(best[fn], run(fn))
-        ind, inter = best[sweep], best[sweep_interacting]
+            for i, fn in enumerate(fns):
+                best[i] = min(best[i], run(fn))
+        ind, inter, curv = best
         lines.append(
-            f"| {label} | {1e3 * ind:.2f} ms | {1e3 * inter:.2f} ms | {inter / ind:.2f}x |"
+            f"| {label} | {1e3 * ind:.2f} ms | {1e3 * inter:.2f} ms ({inter / ind:.1f}x) | "
+            f"{1e3 * curv:.2f} ms ({curv / ind:.1f}x) |"
         )
     for line in lines:
         print(line)
@@ -220,6 +295,11 @@ def main() -> None:
     ap.add_argument("--only", nargs="*", help="cell name prefixes, e.g. 'uniform' 'random 03'")
     ap.add_argument("--timing-only", action="store_true")
     ap.add_argument(
+        "--convergence",
+        action="store_true",
+        help="also refine the BEM grid (384, 768, 1536) on the uniform cells",
+    )
+    ap.add_argument(
         "--threads",
         type=int,
         default=1,
@@ -229,6 +309,8 @@ def main() -> None:
     args = ap.parse_args()
     settings = CellSettings()
     lines = [] if args.timing_only else accuracy(args, settings)
+    if args.convergence:
+        lines += convergence(settings, args.jobs)
     lines += timing(settings, args.threads)
     if args.out:
         head = [

@@ -19,7 +19,11 @@ from metainterface.errors import MetainterfaceError
 from metainterface.physics import curves
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.curves import Curve, Sweep, anchor, delta_grid, interp, sweep, to_grid
-from metainterface.physics.interaction import asperity_sweep_interacting, sweep_interacting
+from metainterface.physics.interaction import (
+    asperity_sweep_interacting,
+    load_area_interacting,
+    sweep_interacting,
+)
 from metainterface.physics.sneddon import area
 
 PHYSICS: tuple[str, ...] = ("independent", "interacting")
@@ -115,10 +119,10 @@ def alpha_at(
     """
     if check_physics(physics) == "independent":
         return curves.alpha_at(gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta)
-    sw = sweep_interacting(gamma, h, settings, smooth=smooth, n_delta=n_delta)
-    zero = torch.zeros_like(sw.p_star[:, :1])
-    p = torch.cat([zero, sw.p_star], dim=-1)
-    return interp(p_star, p, torch.cat([zero, sw.alpha], dim=-1)), p[:, -1]
+    _, p_sw, alpha = load_area_interacting(gamma, h, settings, smooth=smooth, n_delta=n_delta)
+    zero = torch.zeros_like(p_sw[:, :1])
+    p = torch.cat([zero, p_sw], dim=-1)
+    return interp(p_star, p, torch.cat([zero, alpha], dim=-1)), p[:, -1]
 
 
 def alpha_at_loads(
@@ -137,14 +141,18 @@ def alpha_at_loads(
     more or less), so the exact sweep runs past Delta_max, doubling its range at most
     ``max_extend`` times, until it covers every requested P* (nothing is held constant).
     """
-    fn = sweep_for(physics)
+    interacting = check_physics(physics) == "interacting"
     top = p_star.max(dim=-1).values
     span = settings.delta_max
     for _ in range(max_extend + 1):
         delta = torch.linspace(0.0, span, n_delta, dtype=gamma.dtype, device=gamma.device)
-        sw = fn(gamma, h, settings, delta=delta)
-        if bool((sw.p_star[:, -1] >= top).all()):
-            return interp(p_star, sw.p_star, sw.alpha)
+        if interacting:
+            _, p_sw, alpha = load_area_interacting(gamma, h, settings, delta=delta)
+        else:
+            sw = sweep(gamma, h, settings, delta=delta)
+            p_sw, alpha = sw.p_star, sw.alpha
+        if bool((p_sw[:, -1] >= top).all()):
+            return interp(p_star, p_sw, alpha)
         span *= 2.0
     raise MetainterfaceError(
         f"P* up to {float(top.max()):.4g} is not reached by the {physics} model "

@@ -1,11 +1,12 @@
 """Elastic interaction between the asperities of a periodic cell (beyond the paper, issue 9).
 
 The paper's model (``curves.sweep``) compresses asperity i by <Delta - h_i>_+ as if it stood
-alone. In the tiled cell the loads of all asperities also deform the surface around tip i
-through the periodic Boussinesq field of the lattice: a blunt asperity about to engage
-next to loaded ones touches later, and its area, which grows like delta^(2/gamma) with an
-infinite slope at contact, is very sensitive to that. Here the neighbours' field around
-tip i, to second order in the distance r from the tip and averaged over the angle, is
+alone (its section 5 names the interaction as future work). In the tiled cell the loads of
+all asperities also deform the surface around tip i through the periodic Boussinesq field
+of the lattice: a blunt asperity about to engage next to loaded ones touches later, and
+its area, which grows like delta^(2/gamma) with an infinite slope at contact, is very
+sensitive to that. Here the neighbours' field around tip i, to second order in the
+distance r from the tip and averaged over the angle, is
 
     u_i(r) = w_i + b_i r^2,   w_i = sum_j K_ij F_j / E*,   b_i = sum_j C_ij F_j / E*,
 
@@ -16,6 +17,7 @@ profile, with d = kappa c a^gamma the power-law part,
     Delta - h_i - w_i = d_i + 2 b_i a_i^2,   F_i / E* = 2 gamma/(gamma + 1) d_i a_i + 8/3 b_i a_i^3,
 
 solved self-consistently at every Delta; alpha = pi sum a_i^2 / A_nom, P* = sum F_i / (A_nom E*).
+By default b = 0 (the tip shift only; see "Which terms" below).
 
 The kernels (per geometry, computed once, float64). The periodic displacement of a half-space
 under a unit point load on each site of the lattice L Z^2 is (1 / (pi E* L)) g(x / L), g the
@@ -39,23 +41,31 @@ in the paper's model, and the first asperity still touches at Delta = 0.
 What is left out, and why. Loads sit at least a pitch p = 4 a_max apart, a <= a_max, so
 spreading load j over its contact disc changes its field at tip i by a relative
 <r'^2>/(4 p^2) < 1 % (a correction to a correction), and the anisotropic second-order part
-of the field changes the area only at second order; terms of order (a/p)^4 are dropped. The
-curvature term is the largest correction beyond the tip shift: for identical gamma = 4
-asperities near Delta_max it lowers alpha at given P* by 1.2 % (Tamaas goes from -0.6 % to
--0.8 % and -1.05 % on 384, 768 and 1536 grids), 0.1-0.2 % for gamma <= 2; and near
-engagement it regularises a blunt asperity's contact (locally a sphere of radius 1/(2 b)),
-where dalpha/dDelta was infinite. P* at Delta_max is therefore up to ~2 % lower than in the
-paper's model for blunt cells; compare models at equal P* (``forward.alpha_at``).
+of the field changes the area only at second order; terms of order (a/p)^4 are dropped.
+
+Which terms (``curvature``). The tip shift w is the interaction that matters: it moves
+engagements, which is where the paper's model errs by up to 18 % (benchmarks/results/
+interaction.md). The curvature term b is the next one: for identical gamma = 4 asperities
+near Delta_max it lowers alpha at given P* by 1.2 % (Tamaas goes -0.6 %, -0.8 %, -1.05 % on
+384, 768, 1536 grids: towards it), 0.1-0.2 % for gamma <= 2; near engagement it regularises
+a blunt asperity's contact (locally a sphere of radius 1/(2 b)). It is physically right but
+smaller than the error of the BEM it is checked against at 768 x 768 (pixel counting
+overestimates alpha by ~0.5-2 %), it costs ~30 % more, and without it identical asperities
+give exactly the paper's model. So the default is the tip shift only (``CURVATURE``);
+``curvature=True`` adds b, e.g. against finer BEM grids or for blunt-dominated designs. With
+b, P* at Delta_max can be ~2 % lower than in the paper's model; either way the models reach
+different P* at Delta_max, so compare them at equal P* (``forward.alpha_at_loads``).
 
 The solve. A fixed number of Newton sweeps in d (``ITERATIONS``), each taking the
 self-image term and the asperity's own curvature term implicitly (diagonal Newton) and the
 neighbours explicitly; the coupling left is |K_ij| dF_j/ddelta_j <= ~0.04 per pair, so
-three sweeps put alpha within ~1e-3 of the converged solution at worst (typically 1e-5), far
-below the BEM's own error. The sweeps are unrolled, so autograd differentiates through
-them. S* = dP*/dalpha uses the tangent d/dDelta of the equations above at the final state,
-by the same Jacobi scheme. Inside, tensors are laid out (N, B, K) (N asperities, B designs,
-K Delta samples): elementwise passes run along K, each kernel is one (2N, N) matrix product
-and the sums over asperities add contiguous slabs.
+three sweeps put alpha at equal P* within 1.3e-4 of the converged solution at worst (8e-4
+with the curvature term), far below the BEM's own error. The sweeps are unrolled, so
+autograd differentiates through them. S* = dP*/dalpha uses the tangent d/dDelta of the
+equations above at the final state, by the same Jacobi scheme. Inside, tensors are laid
+out (N, B, K) (N asperities, B designs, K Delta samples): elementwise passes run along K,
+the kernels are one matrix product per sweep and the sums over asperities add contiguous
+slabs.
 """
 
 from __future__ import annotations
@@ -75,6 +85,9 @@ from metainterface.physics.sneddon import engagement, indentation, log_kc
 
 #: Newton sweeps of the forward solve (and Jacobi sweeps of its tangent).
 ITERATIONS = 3
+#: Whether the neighbours' curvature term is in the model by default: no (see the docstring,
+#: "Which terms"): at the BEM resolution of the paper it is below the BEM's own error.
+CURVATURE = False
 
 # Ewald splitting on the unit cell: beta = sqrt(pi) balances the two sums; 6 shells of
 # images and of wave vectors on each side reach float64 round-off at any point.
@@ -144,39 +157,42 @@ def _lattice_values(n_side: int) -> tuple[np.ndarray, np.ndarray]:
     return out[0], out[1]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Interaction:
     """The two (N, N) interaction matrices of a lattice, symmetric and circulant.
 
     shift: K [1/length], w_i = sum_j K_ij F_j / E*, zero row and column sums.
-    curvature: C [1/length^3], b_i = sum_j C_ij F_j / E*, positive.
+    curvature: C [1/length^3], b_i = sum_j C_ij F_j / E*, positive; None to leave the
+    neighbours' curvature out (tip shift only).
     """
 
     shift: Tensor
-    curvature: Tensor
+    curvature: Tensor | None
 
     def stacked(self, dtype: torch.dtype, device: torch.device) -> tuple[Tensor, Tensor, Tensor]:
-        """[K; C] and [K - diag K; C] (2N, N), and diag K (N, 1, 1), for the solver (cached)."""
+        """[K; C] and [K - diag K; C] ((2N or N), N) and diag K (N, 1, 1), cached per dtype."""
         key = (dtype, torch.device(device))
         cache = self.__dict__.setdefault("_stacked", {})
         if key not in cache:
             with torch.inference_mode(False):  # plain tensors: usable under autograd later
                 k = self.shift.to(dtype=dtype, device=device)
-                c = self.curvature.to(dtype=dtype, device=device)
                 diag = torch.diagonal(k)
-                off = k - torch.diag_embed(diag)
-                cache[key] = (torch.cat([k, c]), torch.cat([off, c]), diag[:, None, None].clone())
+                blocks, off = [k], [k - torch.diag_embed(diag)]
+                if self.curvature is not None:
+                    c = self.curvature.to(dtype=dtype, device=device)
+                    blocks.append(c)
+                    off.append(c)
+                cache[key] = (torch.cat(blocks), torch.cat(off), diag[:, None, None].clone())
         return cache[key]
 
     def scaled(self, factor: float) -> Interaction:
         """Both matrices times ``factor`` (0 gives the independent model)."""
-        return Interaction(self.shift * factor, self.curvature * factor)
+        c = None if self.curvature is None else self.curvature * factor
+        return Interaction(self.shift * factor, c)
 
-    def to(self, dtype: torch.dtype, device: torch.device | str | None = None) -> Interaction:
-        return Interaction(
-            self.shift.to(dtype=dtype, device=device),
-            self.curvature.to(dtype=dtype, device=device),
-        )
+    def without_curvature(self) -> Interaction:
+        """The tip shift only."""
+        return Interaction(self.shift, None)
 
 
 def interaction(
@@ -185,24 +201,29 @@ def interaction(
     pitch: float | None = None,
     dtype: torch.dtype = torch.float64,
     device: torch.device | str | None = None,
+    curvature: bool = True,
 ) -> Interaction:
     """The lattice's interaction matrices (see the module docstring); cached, read-only.
 
     pitch: site spacing p [length], default L / n = 4 a_max; K scales as 1/p, C as 1/p^3.
+    curvature: False leaves C out (tip shift only).
     """
     pitch = settings.cell_side / settings.n_side if pitch is None else float(pitch)
-    return _interaction(settings.n_side, pitch, dtype, torch.device(device or "cpu"))
+    dev = torch.device(device or "cpu")
+    return _interaction(settings.n_side, pitch, dtype, dev, bool(curvature))
 
 
 @functools.lru_cache(maxsize=64)
-def _interaction(n: int, pitch: float, dtype: torch.dtype, device: torch.device) -> Interaction:
+def _interaction(
+    n: int, pitch: float, dtype: torch.dtype, device: torch.device, curvature: bool
+) -> Interaction:
     side = n * pitch
     g, c = _lattice_values(n)
     k = (g - g.mean(axis=1, keepdims=True)) / (math.pi * side)
     c = c / (4.0 * math.pi * side**3)
     with torch.inference_mode(False):  # plain tensors, also when first called in inference
         as_t = functools.partial(torch.as_tensor, dtype=dtype, device=device)
-        return Interaction(shift=as_t(k), curvature=as_t(c))
+        return Interaction(shift=as_t(k), curvature=as_t(c) if curvature else None)
 
 
 def sweep_interacting(
@@ -215,16 +236,39 @@ def sweep_interacting(
     delta: Tensor | None = None,
     kernel: Interaction | None = None,
     iterations: int = ITERATIONS,
+    curvature: bool = CURVATURE,
 ) -> Sweep:
     """The cell response along Delta with elastic interaction; the contract of ``sweep``.
 
     gamma, h: (B, N) [h in units of R], anchored (min h -> 0). smooth: softplus steepness
     [1/R], None for the exact bracket. n_delta / delta: the (K,) sweep, as in ``sweep``.
-    kernel: the matrices (default ``interaction(settings)``; ``.scaled(0)`` gives ``sweep``).
+    curvature: add the neighbours' curvature term b (default ``CURVATURE``: off, the tip
+    shift only; see the module docstring). kernel: explicit matrices instead
+    (``interaction(...)``, whose curvature may be None; ``.scaled(0)`` gives ``sweep``
+    exactly); overrides ``curvature``.
     iterations: Newton sweeps, each one power-law evaluation of the (N, B, K) state.
     Returns delta (K,) and P*, alpha, S* = dP*/dalpha, (B, K); differentiable throughout.
     """
-    return _solve(gamma, h, settings, smooth, n_delta, delta, kernel, iterations, False)[0]
+    return _solve(gamma, h, settings, smooth, n_delta, delta, kernel, iterations, curvature)[0]
+
+
+def load_area_interacting(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    *,
+    smooth: float | None = None,
+    n_delta: int | None = None,
+    delta: Tensor | None = None,
+    kernel: Interaction | None = None,
+    iterations: int = ITERATIONS,
+    curvature: bool = CURVATURE,
+) -> tuple[Tensor, Tensor, Tensor]:
+    """delta (K,), P* and alpha (B, K) of ``sweep_interacting`` without S* (cheaper)."""
+    sw, _ = _solve(
+        gamma, h, settings, smooth, n_delta, delta, kernel, iterations, curvature, tangent=False
+    )
+    return sw.delta, sw.p_star, sw.alpha
 
 
 def asperity_sweep_interacting(
@@ -237,9 +281,12 @@ def asperity_sweep_interacting(
     delta: Tensor | None = None,
     kernel: Interaction | None = None,
     iterations: int = ITERATIONS,
+    curvature: bool = CURVATURE,
 ) -> tuple[Sweep, Tensor]:
     """``sweep_interacting`` and each asperity's contact area / A_nom, (B, K, N)."""
-    sw, per = _solve(gamma, h, settings, smooth, n_delta, delta, kernel, iterations, True)
+    sw, per = _solve(
+        gamma, h, settings, smooth, n_delta, delta, kernel, iterations, curvature, per_asperity=True
+    )
     assert per is not None
     return sw, per
 
@@ -253,13 +300,18 @@ def _solve(
     delta: Tensor | None,
     kernel: Interaction | None,
     iterations: int,
-    per_asperity: bool,
+    curvature: bool,
+    *,
+    per_asperity: bool = False,
+    tangent: bool = True,
 ) -> tuple[Sweep, Tensor | None]:
     dtype, dev = gamma.dtype, gamma.device
     if delta is None:
         delta = delta_grid(settings, n_delta, dtype=dtype).to(dev)
-    kern = interaction(settings, dtype=dtype, device=dev) if kernel is None else kernel
-    w_and_b, off_and_b, k_diag = kern.stacked(dtype, dev)
+    if kernel is None:
+        kernel = interaction(settings, dtype=dtype, device=dev, curvature=curvature)
+    both, off_and_c, k_diag = kernel.stacked(dtype, dev)
+    curv = kernel.curvature is not None
     k2 = 2.0 * k_diag
     n = gamma.shape[-1]
     floor = _contact_floor(dtype)
@@ -268,21 +320,25 @@ def _solve(
     # over the leading axis and the sums over asperities add contiguous slabs.
     gam = gamma.T[:, :, None]  # (N, B, 1)
     inv_g = 1.0 / gam
-    a_coef = torch.exp(-log_kc(gam, settings.radius) * inv_g)
+    lkc = log_kc(gam, settings.radius)
     f_coef = 2.0 * gam / (gam + 1.0)
     g4 = 4.0 * inv_g
     one = torch.ones((), dtype=dtype, device=dev)
 
-    def apply(mat: Tensor, x: Tensor) -> tuple[Tensor, Tensor]:
-        """(2N, N) matrix on the asperity axis of x (N, B, K): its two (N, B, K) halves."""
-        return (mat @ x.reshape(n, -1)).view(2 * n, *x.shape[1:]).split(n)
+    def apply(mat: Tensor, x: Tensor) -> list[Tensor]:
+        """(M N, N) matrix on the asperity axis of x (N, B, K): its M (N, B, K) blocks."""
+        out = mat @ x.reshape(n, -1)
+        return list(out.view(out.shape[0], *x.shape[1:]).split(n))
 
-    def contact(d: Tensor, b: Tensor) -> tuple[Tensor, Tensor, Tensor, Tensor]:
+    def contact(d: Tensor, b: Tensor | None) -> tuple[Tensor, Tensor, Tensor, Tensor]:
         """Radius a (0 at d = 0), a^2, max(d, floor) and F / E* of compressions d >= 0."""
         safe = torch.clamp_min(d, floor)
-        a = torch.pow(safe, inv_g) * (a_coef * torch.sign(d))
+        # a = (d / kappa c)^(1/gamma); exp-log rather than pow: as fast forward, and its
+        # backward needs no second power evaluation
+        a = torch.exp((torch.log(safe) - lkc) * inv_g) * torch.sign(d)
         a2 = a * a
-        return a, a2, safe, torch.addcmul(f_coef * d, b, a2, value=8.0 / 3.0) * a
+        f = f_coef * d if b is None else torch.addcmul(f_coef * d, b, a2, value=8.0 / 3.0)
+        return a, a2, safe, f * a
 
     def target(gap: Tensor) -> tuple[Tensor, Tensor]:
         """<gap>_+ (or softplus) and its derivative."""
@@ -291,41 +347,53 @@ def _solve(
 
     gap0 = delta[None, None, :] - anchor(h).T[:, :, None]  # (N, B, K)
     d = indentation(gap0, smooth)
-    b = torch.zeros_like(d)
+    b = None
     for _ in range(iterations):
         a, a2, safe, force = contact(d, b)
-        w, b = apply(w_and_b, force)
+        w, *rest = apply(both, force)
         tgt, eng = target(gap0 - w)
-        ba2 = b * a2
-        # Newton on d + 2 b a^2 = <gap>_+, diagonal: d(2 b a^2)/dd = 4 b a^2 / (gamma d) and
-        # the self-image term d(w_i)/dd = K_ii dF_i/dd = K_ii 2 a (1 + ...)
-        resid = torch.add(d, ba2, alpha=2.0) - tgt
-        slope = torch.addcmul(torch.addcmul(one, g4, ba2 / safe), k2 * a, eng)
+        # Newton on d + 2 b a^2 = <gap>_+, diagonal: the self-image term dw_i/dd_i =
+        # K_ii dF_i/dd_i = K_ii 2 a (1 + ...), and d(2 b a^2)/dd = 4 b a^2 / (gamma d)
+        slope = torch.addcmul(one, k2 * a, eng)
+        if curv:
+            b = rest[0]
+            ba2 = b * a2
+            resid = torch.add(d, ba2, alpha=2.0) - tgt
+            slope = torch.addcmul(slope, g4, ba2 / safe)
+        else:
+            resid = d - tgt
         d = torch.clamp_min(torch.addcdiv(d, resid, slope, value=-1.0), 0.0)
 
     a, a2, safe, force = contact(d, b)
-    eng = target(gap0 - apply(w_and_b, force)[0])[1] * torch.sign(d)
+    a_nom = settings.nominal_area
+    p_star = force.sum(0) / a_nom
+    alpha = (math.pi / a_nom) * a2.sum(0)
+    per = (math.pi / a_nom) * a2.permute(1, 2, 0) if per_asperity else None
+    if not tangent:
+        return Sweep(delta=delta, p_star=p_star, alpha=alpha, stiffness=p_star * math.nan), per
+    eng = target(gap0 - apply(both, force)[0])[1] * torch.sign(d)
     # Tangent along Delta: with t_i = d(total compression)/dDelta at fixed b_i, db = dB/dDelta,
     #   t_i + 2 a_i^2 db_i = e_i (1 - sum_j K_ij dF_j),  dF_j = 2 a_j t_j + 8/3 a_j^3 db_j,
     #   db = C dF,  dalpha_i = 2 pi a_i^2 t_i / (gamma_i d_i + 4 b_i a_i^2) / A_nom;
     # Jacobi sweeps with the self term K_ii 2 a_i t_i on the left.
     two_a = 2.0 * a
-    cube = (8.0 / 3.0) * a2 * a
     denom = torch.addcmul(one, k_diag * two_a, eng)
     p_t = eng / denom
-    q_t = torch.addcmul(2.0 * a2, k_diag * cube, eng) / denom
     t = p_t
     dforce = two_a * t
+    if curv:
+        cube = (8.0 / 3.0) * a2 * a
+        q_t = torch.addcmul(2.0 * a2, k_diag * cube, eng) / denom
     for _ in range(max(iterations - 1, 1)):
-        kf, db = apply(off_and_b, dforce)
-        t = p_t - torch.addcmul(p_t * kf, q_t, db)
-        dforce = torch.addcmul(two_a * t, cube, db)
-    darea = a2 * t / torch.addcmul(gam * safe, b, a2, value=4.0)
-    a_nom = settings.nominal_area
-    p_star = force.sum(0) / a_nom
-    alpha = (math.pi / a_nom) * a2.sum(0)
-    darea = (2.0 * math.pi) * darea.sum(0)
+        kf, *rest = apply(off_and_c, dforce)
+        if curv:
+            t = p_t - torch.addcmul(p_t * kf, q_t, rest[0])
+            dforce = torch.addcmul(two_a * t, cube, rest[0])
+        else:
+            t = p_t - p_t * kf
+            dforce = two_a * t
+    spread = gam * safe if b is None else torch.addcmul(gam * safe, b, a2, value=4.0)
+    darea = (2.0 * math.pi) * (a2 * t / spread).sum(0)
     in_contact = darea > 0
     stiffness = torch.where(in_contact, dforce.sum(0) / torch.where(in_contact, darea, 1.0), 0.0)
-    sw = Sweep(delta=delta, p_star=p_star, alpha=alpha, stiffness=stiffness)
-    return sw, ((math.pi / a_nom) * a2.permute(1, 2, 0) if per_asperity else None)
+    return Sweep(delta=delta, p_star=p_star, alpha=alpha, stiffness=stiffness), per
