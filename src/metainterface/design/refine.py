@@ -23,8 +23,7 @@ from torch.nn import functional as nnf
 
 from metainterface.design import lbfgs
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import alpha_at
-from metainterface.physics.forward import DEFAULT_PHYSICS, sweep_for
+from metainterface.physics.forward import DEFAULT_PHYSICS, alpha_at
 
 DTYPE = torch.float64
 
@@ -104,9 +103,7 @@ def masked_loss(
     physics: str = DEFAULT_PHYSICS,
 ) -> Tensor:
     """The weighted MSE of appendix C per row (B,), relative to mean(alpha_t^2)."""
-    alpha, p_max = alpha_at(
-        gamma, h, settings, target.p, smooth=smooth, sweep_fn=sweep_for(physics)
-    )
+    alpha, p_max = alpha_at(gamma, h, settings, target.p, physics=physics, smooth=smooth)
     w = torch.where(target.p <= p_max[:, None], 1.0, undershoot)
     err = (w * (alpha - target.alpha) ** 2).sum(-1) / w.sum(-1)
     return err / (target.alpha**2).mean(-1)
@@ -122,7 +119,7 @@ def relative_error(
     """||alpha_design - alpha_target||_2 / ||alpha_target||_2 on the target's grid (exact
     physics, the design's curve held at its last value where it stops short). (B,)."""
     with torch.no_grad():
-        alpha, _ = alpha_at(gamma, h, settings, target.p, sweep_fn=sweep_for(physics))
+        alpha, _ = alpha_at(gamma, h, settings, target.p, physics=physics)
         return torch.linalg.vector_norm(alpha - target.alpha, dim=-1) / torch.linalg.vector_norm(
             target.alpha, dim=-1
         )
