@@ -115,14 +115,25 @@ def alpha_at(
 ) -> tuple[Tensor, Tensor]:
     """``curves.alpha_at`` under a choice of model: alpha (B, M) at p_star (B, M), P*_max (B,).
 
-    Same convention: the origin prepended, alpha held at its last value beyond P*_max.
+    Same convention (alpha held at its last value beyond P*_max); the interacting model is
+    run without its stiffness tangent, which alpha does not need (~25 % cheaper).
     """
-    if check_physics(physics) == "independent":
-        return curves.alpha_at(gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta)
-    _, p_sw, alpha = load_area_interacting(gamma, h, settings, smooth=smooth, n_delta=n_delta)
-    zero = torch.zeros_like(p_sw[:, :1])
-    p = torch.cat([zero, p_sw], dim=-1)
-    return interp(p_star, p, torch.cat([zero, alpha], dim=-1)), p[:, -1]
+    fn = sweep if check_physics(physics) == "independent" else _load_area_sweep
+    return curves.alpha_at(gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta, sweep_fn=fn)
+
+
+def _load_area_sweep(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    *,
+    smooth: float | None = None,
+    n_delta: int | None = None,
+    delta: Tensor | None = None,
+) -> Sweep:
+    """The interacting sweep without S* (its stiffness is NaN): for alpha(P*) only."""
+    d, p, a = load_area_interacting(gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta)
+    return Sweep(delta=d, p_star=p, alpha=a, stiffness=torch.full_like(p, float("nan")))
 
 
 def alpha_at_loads(
