@@ -25,6 +25,7 @@ import argparse
 import functools
 import json
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -316,7 +317,7 @@ def main() -> None:
         head = [
             "# Interaction-aware forward model against BEM (issue 9)",
             "",
-            f"`python benchmarks/bench_interaction.py --grid {args.grid}`; "
+            f"`python benchmarks/bench_interaction.py {' '.join(sys.argv[1:])}`; "
             f"Tamaas PKR tolerance 1e-11; N = 9, Delta_max = R/50, gamma in [1.8, 4].",
             "",
         ]
