@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import sweep
@@ -43,6 +44,8 @@ def plot_reconstructions(test, pred, settings: CellSettings, per_category: int =
                 label=f"err {100 * pred.curve_error[i]:.1f} %",
             )
         ax.set(title=f"({letter}) {name}", xlabel="$P^*$", ylabel=r"$\alpha$")
+        ax.xaxis.set_major_locator(MaxNLocator(4))
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 2))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, title="true (black) / predicted", title_fontsize=7)
     return fig
