@@ -123,35 +123,33 @@ def run(args: argparse.Namespace) -> int:
     extra = None
     limit = None
     if args.max_pressure:
+        from metainterface.physics.limits import pressure_penalty
+
         limit = parse_pressure_limit(args.max_pressure, e_star=e_star)
+
+        def extra(gamma, h, settings, limit=limit):
+            return 10.0 * pressure_penalty(gamma, h, settings, limit)
+
     methods = ["surrogate", "multistart", "hertz"] if args.compare else [args.method]
-    from metainterface.physics.cell import CellSettings
-
-    for t in targets:
-        for w in reachability_warnings(t, CellSettings()):
-            print(f"warning: {w}", file=sys.stderr)
-    all_results = []
-    for method in methods:
-        if limit is not None:
-            from metainterface.physics.limits import pressure_penalty
-
-            def extra(gamma, h, limit=limit):
-                return 10.0 * pressure_penalty(gamma, h, CellSettings(), limit)
-
-        all_results.append(
-            design(
-                targets,
-                method,
-                refine_designs=args.refine == "lbfgs",
-                model_path=args.model,
-                starts=args.starts,
-                seed=args.seed,
-                extra_loss=extra,
-                physics=args.physics,
-                hedge=args.hedge if method == "surrogate" else 0,
-            )
+    all_results = [
+        design(
+            targets,
+            method,
+            refine_designs=args.refine == "lbfgs",
+            model_path=args.model,
+            starts=args.starts,
+            seed=args.seed,
+            extra_loss=extra,
+            physics=args.physics,
+            hedge=args.hedge if method == "surrogate" else 0,
         )
-    from metainterface.io.report import write_design_outputs
+        for method in methods
+    ]
+    for t, r in zip(targets, all_results[0], strict=True):
+        for w in reachability_warnings(t, r.settings):
+            print(f"warning: {w}", file=sys.stderr)
+    from metainterface.io.report import pressure_check, write_design_outputs
+    from metainterface.physics.cell import Design
 
     out = Path(args.out)
     rows = []
@@ -159,7 +157,13 @@ def run(args: argparse.Namespace) -> int:
         per_method = [res[i] for res in all_results]
         for r in per_method:
             folder = out / t.name if len(methods) == 1 else out / t.name / r.method
-            write_design_outputs(folder, r, args=args, pressure_limit=limit, e_star=e_star)
+            check = None
+            if limit is not None:
+                check = pressure_check(
+                    Design(gamma=r.gamma, h=r.h, settings=r.settings), limit, e_star
+                )
+                print(f"{t.name} ({r.method}): {check.summary()}")
+            write_design_outputs(folder, r, args=args, pressure=check)
             rows.append((t.name, r.method, r.initial_error, r.error, r.seconds, folder))
         if args.compare:
             from metainterface.plots import plot_comparison, save_figure
@@ -169,14 +173,6 @@ def run(args: argparse.Namespace) -> int:
                 out / t.name / "compare.png",
                 command="design --compare",
             )
-    if limit is not None:
-        from metainterface.io.report import pressure_check
-        from metainterface.physics.cell import Design
-
-        for res in all_results:
-            for r in res:
-                d = Design(gamma=r.gamma, h=r.h, settings=r.settings)
-                print(f"{r.target.name} ({r.method}): {pressure_check(d, limit, e_star).summary()}")
     print(f"{'target':<14}{'method':<12}{'zero-shot':>10}{'error':>9}{'seconds':>9}  output")
     for name, method, e0, e, sec, folder in rows:
         print(f"{name:<14}{method:<12}{100 * e0:>9.2f}%{100 * e:>8.2f}%{sec:>9.2f}  {folder}")

@@ -50,10 +50,12 @@ def _direction(g: Tensor, hist: list[tuple[Tensor, Tensor, Tensor]]) -> Tensor:
         q -= a[:, None] * y
         alphas.append(a)
     scale = torch.ones_like(g[:, 0])
+    found = torch.zeros_like(scale, dtype=torch.bool)
     for s, y, rho in reversed(hist):  # newest valid pair sets the initial Hessian scale
         sy, yy = (s * y).sum(-1), (y * y).sum(-1)
-        use = (rho > 0) & (scale == 1.0)
+        use = (rho > 0) & ~found
         scale = torch.where(use, sy / yy.clamp_min(1e-300), scale)
+        found |= use
     r = q * scale[:, None]
     for (s, y, rho), a in zip(hist, reversed(alphas), strict=True):
         b = rho * (y * r).sum(-1)

@@ -89,7 +89,7 @@ def design(
     starts: int = 50,
     seed: int = 0,
     refine_settings: RefineSettings | None = None,
-    extra_loss: Callable[[Tensor, Tensor], Tensor] | None = None,
+    extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
     physics: str = DEFAULT_PHYSICS,
     hedge: int = 0,
 ) -> list[DesignResult]:

@@ -131,12 +131,12 @@ def refine(
     target: TargetGrid,
     rs: RefineSettings | None = None,
     hertz: bool = False,
-    extra_loss: Callable[[Tensor, Tensor], Tensor] | None = None,
+    extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
     physics: str = DEFAULT_PHYSICS,
 ) -> Tensor:
     """Run the stages on a batch of unbounded parameters (B, D); each row is its own problem
-    against the matching row of ``target``. ``extra_loss(gamma, h) -> (B,)`` is added if given
-    (e.g. a pressure limit). Returns the refined raw parameters."""
+    against the matching row of ``target``. ``extra_loss(gamma, h, settings) -> (B,)`` is
+    added if given (e.g. a pressure limit). Returns the refined raw parameters."""
     rs = rs or RefineSettings()
     x = raw.detach().to(DTYPE)
     for kappa in rs.kappas():
@@ -144,7 +144,7 @@ def refine(
         def fun(z: Tensor, kappa: float = float(kappa)) -> Tensor:
             gamma, h = to_design(z, settings, hertz)
             loss = masked_loss(gamma, h, settings, target, kappa, rs.undershoot_weight, physics)
-            return loss if extra_loss is None else loss + extra_loss(gamma, h)
+            return loss if extra_loss is None else loss + extra_loss(gamma, h, settings)
 
         x = lbfgs.minimize(fun, x, lr=rs.lr, max_iter=rs.steps_per_stage * rs.iterations).x
     return x

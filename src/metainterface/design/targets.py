@@ -60,7 +60,7 @@ def _design_target(name: str, gamma: list[float], h_frac: list[float], source: s
         sw.alpha[0].numpy(),
         sw.stiffness[0].numpy(),
         source,
-        {"gamma": gamma, "h": (h[0] / 1).tolist()},
+        {"gamma": gamma, "h": h[0].tolist()},
     )
 
 

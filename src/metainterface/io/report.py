@@ -10,12 +10,11 @@ from metainterface.io.csvfiles import write_columns
 from metainterface.io.design_file import save_design
 from metainterface.physics.cell import Design
 from metainterface.physics.forward import design_sweep_for
+from metainterface.physics.limits import PressureCheck, check_pressure
 
 
-def pressure_check(design: Design, limit: float, e_star: float | None = None):
+def pressure_check(design: Design, limit: float, e_star: float | None = None) -> PressureCheck:
     """Peak pressures of a design against a limit given as p/E* (reported in Pa with E*)."""
-    from metainterface.physics.limits import check_pressure
-
     # check_pressure takes a stress [Pa] when it is given the modulus
     if e_star:
         return check_pressure(design, limit * e_star, e_star=e_star)
@@ -27,8 +26,7 @@ def write_design_outputs(
     result: Any,
     *,
     args: argparse.Namespace | None = None,
-    pressure_limit: float | None = None,
-    e_star: float | None = None,
+    pressure: PressureCheck | None = None,
 ) -> Path:
     """Write the four outputs of one designed cell into ``folder``; returns design.json."""
     t = result.target
@@ -54,8 +52,8 @@ def write_design_outputs(
     }
     if args is not None:
         extra["command"] = {k: v for k, v in vars(args).items() if k != "func"}
-    if pressure_limit is not None:
-        extra["pressure_check"] = pressure_check(d, pressure_limit, e_star).to_dict()
+    if pressure is not None:
+        extra["pressure_check"] = pressure.to_dict()
     if args is not None and args.radius and args.modulus:
         from metainterface.io.physical import physical_block
         from metainterface.io.units import parse_area, parse_force, parse_length, parse_pressure

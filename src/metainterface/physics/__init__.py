@@ -1,6 +1,6 @@
 """The forward model: pure, batched torch functions (no I/O)."""
 
-from metainterface.physics.cell import CellSettings, Design, validate_batch
+from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.curves import (
     Curve,
     Sweep,
@@ -51,5 +51,4 @@ __all__ = [
     "shape_constant",
     "sweep",
     "to_grid",
-    "validate_batch",
 ]

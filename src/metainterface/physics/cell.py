@@ -185,23 +185,3 @@ def _as_vector(name: str, values: Any) -> np.ndarray:
     if bad.size:
         raise MetainterfaceError(f"{name}[{int(bad[0])}] is {arr[bad[0]]}; values must be finite")
     return arr
-
-
-def validate_batch(gamma: torch.Tensor, h: torch.Tensor, settings: CellSettings) -> None:
-    """Check a (B, N) batch of designs against the settings; raise MetainterfaceError."""
-    if gamma.ndim != 2 or gamma.shape != h.shape:
-        raise MetainterfaceError(
-            f"gamma and h must both be (batch, N) arrays of one shape, "
-            f"got {tuple(gamma.shape)} and {tuple(h.shape)}"
-        )
-    if gamma.shape[1] != settings.n_asperities:
-        raise MetainterfaceError(
-            f"designs have {gamma.shape[1]} asperities, settings say n_asperities = "
-            f"{settings.n_asperities}"
-        )
-    if not (torch.isfinite(gamma).all() and torch.isfinite(h).all()):
-        raise MetainterfaceError("gamma and h must be finite (found NaN or inf)")
-    if (gamma <= 1).any():
-        raise MetainterfaceError("gamma must be > 1 (the cone limit) for every asperity")
-    if (h < 0).any():
-        raise MetainterfaceError("h must be >= 0 for every asperity")
