@@ -12,6 +12,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.physics import CellSettings
 from metainterface.surrogate.checkpoint import load_model
 from metainterface.surrogate.data import split_of
+from metainterface.surrogate.loss import LossWeights, weights_of
 from metainterface.surrogate.model import InverseMLP, outputs_to_design
 from metainterface.surrogate.schedules import Schedules
 from metainterface.surrogate.train import TrainConfig, read_metrics, train
@@ -37,8 +38,26 @@ def test_output_mapping_sorted_and_bounded():
     gamma, h = outputs_to_design(y, S)
     assert float(gamma.min()) >= 1.8 and float(gamma.max()) <= 4.0
     assert torch.all(h[:, 0] == 0) and torch.all(h.diff(dim=-1) >= 0)
-    ones = outputs_to_design(torch.ones(1, 18), S)[1]
-    assert float(ones[0, -1]) == pytest.approx(2 * S.delta_max)
+    paper = outputs_to_design(torch.ones(1, 18), S, max_gap=None)[1]
+    assert float(paper[0, -1]) == pytest.approx(2 * S.delta_max)
+    wide = outputs_to_design(torch.ones(1, 18), S, max_gap=1.1)[1]
+    assert float(wide[0, 1]) == pytest.approx(1.1 * S.delta_max)
+
+
+def test_default_gap_scale_reaches_truncated_designs():
+    # a truncated cell: one active asperity, the rest beyond Delta_max
+    m = InverseMLP(9, 128)
+    y = torch.zeros(1, 18)
+    y[0, 10] = 1.0
+    h = outputs_to_design(y, S, m.max_gap)[1]
+    assert float(h[0, 1]) > S.delta_max
+
+
+def test_cli_defaults_match_train_config():
+    from metainterface.cli.train import DEFAULTS
+
+    cfg = TrainConfig()
+    assert {k: getattr(cfg, k) for k in DEFAULTS} == DEFAULTS
 
 
 def test_schedules():
@@ -92,8 +111,10 @@ def test_loss_falls_and_resume_is_bit_for_bit(tiny, tmp_path):
     a = read_metrics(full.run_dir)
     b = read_metrics(part)
     np.testing.assert_array_equal(a["val_loss"], b["val_loss"])
-    ma, _, _ = load_model(full.run_dir / "model.pt")
+    ma, _, config = load_model(full.run_dir / "model.pt")
     mb, _, _ = load_model(part / "model.pt")
+    # the gap scale and loss weights travel with the model file
+    assert ma.max_gap == cfg.max_gap and weights_of(config) == cfg.weights
     for (ka, va_), (_, vb) in zip(ma.state_dict().items(), mb.state_dict().items(), strict=True):
         assert torch.equal(va_, vb), ka
 
@@ -122,6 +143,20 @@ def test_bad_inputs(tiny, tmp_path):
         )
         == 2
     )
+
+
+def test_model_files_keep_the_gap_scale(tmp_path):
+    from metainterface.surrogate.checkpoint import save_model
+
+    paper = InverseMLP(9, 128, max_gap=None)
+    save_model(tmp_path / "p.pt", paper, {"settings": S.to_dict(), "model": paper.architecture()})
+    assert load_model(tmp_path / "p.pt")[0].max_gap is None
+    # files written before the gap scale was a setting hold the paper's network
+    save_model(tmp_path / "old.pt", paper, {"settings": S.to_dict()})
+    model, _, config = load_model(tmp_path / "old.pt")
+    assert model.max_gap is None and weights_of(config) == LossWeights(10, 1, 10)
+    with pytest.raises(MetainterfaceError, match="max_gap"):
+        InverseMLP(9, 128, max_gap=0.0)
 
 
 def test_shipped_model_loads():

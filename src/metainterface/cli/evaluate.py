@@ -27,12 +27,13 @@ def run(args: argparse.Namespace) -> int:
     from metainterface.surrogate.checkpoint import default_model_path, load_model
     from metainterface.surrogate.data import split_of
     from metainterface.surrogate.evaluate import evaluate, format_table, predict_split
+    from metainterface.surrogate.loss import weights_of
 
     model_path = args.model or default_model_path()
-    model, settings, _ = load_model(model_path)
+    model, settings, config = load_model(model_path)
     ds = load_dataset(args.dataset, settings)
     train, test = split_of(ds, "train"), split_of(ds, "test")
-    result = evaluate(model, train, test, settings)
+    result = evaluate(model, train, test, settings, weights_of(config))
     print(format_table(result))
     if args.out:
         record = {

@@ -6,6 +6,38 @@ import argparse
 
 from metainterface.cli.common import positive_int
 
+# TrainConfig's defaults, repeated here so that `--help` needs no torch import; a test
+# checks that they agree.
+DEFAULTS = {
+    "epochs": 500,
+    "batch_size": 1024,
+    "lr": 2e-3,
+    "patience": 50,
+    "curriculum_epochs": 20,
+    "max_gap": 1.1,
+    "w_shape": 10.0,
+    "w_grad": 1.0,
+    "w_mag": 1000.0,
+}
+
+
+PAPER = {"shape": 10, "grad": 1, "mag": 10}
+
+
+def gap_scale(text: str) -> float | None:
+    """--max-gap: a number in (0, 10] (units of Delta_max) or 'paper'."""
+    if text == "paper":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value <= 10:
+        raise argparse.ArgumentTypeError(
+            f"expected a number in (0, 10] (units of Delta_max) or 'paper', got {text!r}"
+        )
+    return value
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
@@ -16,17 +48,40 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--dataset", help="dataset .npz from `metainterface generate`")
     p.add_argument("--out", help="run folder")
-    p.add_argument("--epochs", type=positive_int, default=500)
-    p.add_argument("--batch-size", type=positive_int, default=1024)
+    p.add_argument("--epochs", type=positive_int, default=DEFAULTS["epochs"])
+    p.add_argument("--batch-size", type=positive_int, default=DEFAULTS["batch_size"])
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--lr", type=float, default=2e-3, help="peak learning rate (AdamW)")
-    p.add_argument("--patience", type=positive_int, default=50, help="early-stopping patience")
+    p.add_argument("--lr", type=float, default=DEFAULTS["lr"], help="peak learning rate (AdamW)")
+    p.add_argument(
+        "--patience",
+        type=positive_int,
+        default=DEFAULTS["patience"],
+        help="early-stopping patience",
+    )
     p.add_argument(
         "--curriculum-epochs",
         type=int,
-        default=20,
+        default=DEFAULTS["curriculum_epochs"],
         help="epochs over which the parameter anchor lambda falls linearly to 0",
     )
+    p.add_argument(
+        "--max-gap",
+        type=gap_scale,
+        default=DEFAULTS["max_gap"],
+        help="largest height gap between consecutive asperities the network can output, in "
+        "units of Delta_max (default %(default)s); 'paper' for the paper's 2/(N-1)",
+    )
+    for name, what in (
+        ("shape", "L1 of alpha_hat and S_hat"),
+        ("grad", "L1 of the S_hat differences"),
+        ("mag", "squared log10 errors of P*_max and alpha_max"),
+    ):
+        p.add_argument(
+            f"--w-{name}",
+            type=float,
+            default=DEFAULTS[f"w_{name}"],
+            help=f"loss weight of the {what} (default %(default)s; the paper's: {PAPER[name]})",
+        )
     p.add_argument("--resume", action="store_true", help="continue the run in --out")
     p.add_argument("--plot", metavar="RUN_DIR", help="draw the training panels of a run")
     p.add_argument("--figure", help="with --plot: figure path (default RUN_DIR/training.png)")
@@ -60,6 +115,10 @@ def run(args: argparse.Namespace) -> int:
         lr=args.lr,
         patience=args.patience,
         curriculum_epochs=args.curriculum_epochs,
+        max_gap=args.max_gap,
+        w_shape=args.w_shape,
+        w_grad=args.w_grad,
+        w_mag=args.w_mag,
     )
     result = train(
         split_of(ds, "train"),

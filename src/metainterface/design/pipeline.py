@@ -12,6 +12,7 @@ import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -31,6 +32,9 @@ from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import alpha_at
 from metainterface.physics.forward import DEFAULT_PHYSICS, check_physics
+
+if TYPE_CHECKING:  # the surrogate (and its imports) load only when a design needs it
+    from metainterface.surrogate.model import InverseMLP
 
 METHODS = ("surrogate", "multistart", "hertz")
 
@@ -67,15 +71,13 @@ def _starts(
 
 
 def predict(
-    model: torch.nn.Module, targets: Sequence[Target], settings: CellSettings
+    model: InverseMLP, targets: Sequence[Target], settings: CellSettings
 ) -> tuple[Tensor, Tensor]:
     """Zero-shot designs (T, N) for the targets from the surrogate."""
-    from metainterface.surrogate.model import outputs_to_design
-
     feats = torch.stack([target_features(t, settings.n_steps) for t in targets])
     model.eval()
     with torch.no_grad():
-        gamma, h = outputs_to_design(model(feats), settings)
+        gamma, h = model.design(feats, settings)
     return gamma.to(DTYPE), h.to(DTYPE)
 
 

@@ -37,6 +37,7 @@ from metainterface.reproduce.scales import PAPER, Scale
 from metainterface.surrogate.checkpoint import default_model_path, load_model
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.evaluate import Predictions, evaluate, predict_split
+from metainterface.surrogate.loss import weights_of
 from metainterface.surrogate.train import TrainConfig, read_metrics, train
 from metainterface.validation import available_cpus, validate_design
 
@@ -262,7 +263,7 @@ def stage_fig3(ctx: Context) -> dict[str, Any]:
     test_ds = per_category(ds, "test", ctx.scale.test_per_category)
     gap_ds = per_category(ds, "train", ctx.scale.gap_train_per_category)
     test = split_of(test_ds, "test")
-    result = evaluate(model, split_of(gap_ds, "train"), test, settings)
+    result = evaluate(model, split_of(gap_ds, "train"), test, settings, weights_of(config))
     pred = predict_split(model, test, settings)
     ctx.data.update(settings=settings, dataset=ds, test=test_ds, pred=pred, model_config=config)
 
@@ -360,10 +361,12 @@ def stage_fig4(ctx: Context) -> dict[str, Any]:
         dataset_info={"samples": len(tr), "seed": ds.seed, "note": "reproduce fig. 4"},
     )
     metrics = read_metrics(run_dir)
-    small, _, _ = load_model(run_dir / "model.pt")
+    small, _, small_config = load_model(run_dir / "model.pt")
     test = split_of(ctx.data["test"], "test")
     gap_ds = per_category(ds, "train", sc.gap_train_per_category)
-    small_eval = evaluate(small, split_of(gap_ds, "train"), test, settings)
+    small_eval = evaluate(
+        small, split_of(gap_ds, "train"), test, settings, weights_of(small_config)
+    )
     val = metrics["val_loss"]
     jumps = val[1:] / val[:-1] - 1.0
     ctx.save(

@@ -56,9 +56,11 @@ def load_model(path: str | os.PathLike[str]) -> tuple[InverseMLP, CellSettings, 
     config = blob["config"]
     try:
         settings = CellSettings(**config["settings"])
-        model = InverseMLP(settings.n_asperities, settings.n_steps)
+        # files made before the gap scale was a setting used the paper's (max_gap None)
+        arch = config.get("model", {"max_gap": None})
+        model = InverseMLP(settings.n_asperities, settings.n_steps, arch["max_gap"])
         model.load_state_dict(blob["state_dict"])
-    except (KeyError, TypeError, RuntimeError) as exc:
+    except (KeyError, TypeError, RuntimeError, MetainterfaceError) as exc:
         raise MetainterfaceError(f"model {path}: inconsistent weights file ({exc})") from None
     model.eval()
     return model, settings, config

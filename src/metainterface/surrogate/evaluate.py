@@ -16,7 +16,8 @@ import torch
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import alpha_at, curve
 from metainterface.surrogate.data import Split
-from metainterface.surrogate.model import InverseMLP, outputs_to_design
+from metainterface.surrogate.loss import PAPER_WEIGHTS, LossWeights
+from metainterface.surrogate.model import InverseMLP
 from metainterface.surrogate.train import evaluate_loss
 
 
@@ -41,7 +42,7 @@ def predict_split(
         for lo in range(0, len(split), chunk):
             idx = torch.arange(lo, min(lo + chunk, len(split)))
             feats, t, _, _ = split.rows(idx)
-            gamma, h = outputs_to_design(model(feats), settings)
+            gamma, h = model.design(feats, settings)
             gamma, h = gamma.double(), h.double()
             p_grid = (
                 torch.linspace(0, 1, settings.n_steps, dtype=torch.float64)[None]
@@ -66,8 +67,15 @@ def predict_split(
     return Predictions(split.category, cat(errs), cat(lp), cat(la), cat(gs), cat(hs))
 
 
-def evaluate(model: InverseMLP, train: Split, test: Split, settings: CellSettings) -> dict:
-    """The evaluation table: per category and overall, plus the train/test loss gap."""
+def evaluate(
+    model: InverseMLP,
+    train: Split,
+    test: Split,
+    settings: CellSettings,
+    weights: LossWeights = PAPER_WEIGHTS,
+) -> dict:
+    """The evaluation table: per category and overall, plus the train/test loss gap (the
+    loss with ``weights``: those the model was trained with, see :func:`weights_of`)."""
     pred = predict_split(model, test, settings)
     rows = {}
     for name in [*sorted(set(pred.category.tolist())), "all"]:
@@ -79,8 +87,8 @@ def evaluate(model: InverseMLP, train: Split, test: Split, settings: CellSetting
             "mean_abs_log10_p_star_max_error": float(pred.log_p_error[m].mean()),
             "mean_abs_log10_alpha_max_error": float(pred.log_alpha_error[m].mean()),
         }
-    train_loss = evaluate_loss(model, train, settings)
-    test_loss = evaluate_loss(model, test, settings)
+    train_loss = evaluate_loss(model, train, settings, weights)
+    test_loss = evaluate_loss(model, test, settings, weights)
     return {
         "categories": rows,
         "train_loss": train_loss,

@@ -24,6 +24,20 @@ class LossWeights:
     mag: float = 10.0
 
 
+PAPER_WEIGHTS = LossWeights()
+
+
+def weights_of(model_config: dict) -> LossWeights:
+    """The loss weights a model was trained with (its file's config; the paper's if absent)."""
+    train = model_config.get("train", {})
+    default = PAPER_WEIGHTS
+    return LossWeights(
+        shape=train.get("w_shape", default.shape),
+        grad=train.get("w_grad", default.grad),
+        mag=train.get("w_mag", default.mag),
+    )
+
+
 @dataclass(frozen=True)
 class CurveTargets:
     """Normalised target curves: alpha_hat, stiffness_hat (B, n); p_star_max, alpha_max (B,)."""
