@@ -100,6 +100,20 @@ def test_gradcheck_float64():
         assert torch.autograd.gradcheck(f, (g, h), eps=1e-7, atol=1e-6, rtol=1e-4)
 
 
+@pytest.mark.parametrize("smooth", [None, 1e3, 3e4])
+def test_sweep_gradcheck_all_outputs(smooth):
+    # the sweep's hand-written backward against finite differences, stiffness included
+    g, h = random_designs(3, seed=11)
+    g.requires_grad_()
+    h.requires_grad_()
+
+    def f(gg, hh):
+        sw = sweep(gg, hh, S, smooth=smooth, n_delta=24)
+        return sw.p_star, sw.alpha, sw.stiffness
+
+    assert torch.autograd.gradcheck(f, (g, h), eps=1e-8, atol=1e-6, rtol=1e-4)
+
+
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
 @pytest.mark.parametrize("smooth", [None, 1e3, 1e5])
 def test_gradients_finite_at_first_contact(dtype, smooth):
