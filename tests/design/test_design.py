@@ -34,6 +34,21 @@ def test_batched_lbfgs_rows_are_independent():
     np.testing.assert_allclose(r.x, torch.stack([a, a**2], 1), atol=1e-4)
 
 
+def test_lbfgs_stall_stops_only_the_stalled_row():
+    # row 0 creeps down a nearly flat slope, row 1 is a plain quadratic
+    def fun(x):
+        creep = 1.0 + 1e-3 * torch.exp(-x[0, 0])
+        return torch.stack([creep, ((x[1] - 3.0) ** 2).sum()])
+
+    x0 = torch.zeros(2, 2, dtype=torch.float64)
+    free = minimize(fun, x0, max_iter=60, tol_grad=0.0, tol_change=0.0, tol_loss=0.0, tol_stall=0.0)
+    stalled = minimize(
+        fun, x0, max_iter=60, tol_grad=0.0, tol_change=0.0, tol_loss=0.0, tol_stall=1e-3
+    )
+    assert stalled.x[0, 0] < free.x[0, 0]  # the creeping row stopped early ...
+    np.testing.assert_allclose(stalled.x[1], [3.0, 3.0], atol=1e-6)  # ... the other did not
+
+
 def test_parameterisation_round_trip():
     g = torch.tensor([[2.0, 3.0, 1.9, 3.9]], dtype=torch.float64)
     h = torch.tensor([[0.004, 0.0, 0.01, 0.002]], dtype=torch.float64)

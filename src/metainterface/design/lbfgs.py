@@ -41,6 +41,18 @@ def _value_and_grad(fun: Callable[[Tensor], Tensor], x: Tensor) -> tuple[Tensor,
     return f, g
 
 
+def _rows_value_and_grad(
+    fun: Callable[[Tensor, Tensor], Tensor], x: Tensor, rows: Tensor
+) -> tuple[Tensor, Tensor]:
+    """Loss and gradient of the rows where ``rows`` (B,) is True; inf and 0 elsewhere."""
+    idx = rows.nonzero().squeeze(1)
+    f = torch.full_like(x[:, 0], torch.inf)
+    g = torch.zeros_like(x)
+    if idx.numel():
+        f[idx], g[idx] = _value_and_grad(lambda z: fun(z, idx), x[idx])
+    return f, g
+
+
 def _direction(g: Tensor, hist: list[tuple[Tensor, Tensor, Tensor]]) -> Tensor:
     """-H g by the two-loop recursion, per row; pairs with rho = 0 are skipped."""
     q = g.clone()
@@ -64,27 +76,43 @@ def _direction(g: Tensor, hist: list[tuple[Tensor, Tensor, Tensor]]) -> Tensor:
 
 
 def minimize(
-    fun: Callable[[Tensor], Tensor],
+    fun: Callable[..., Tensor],
     x0: Tensor,
     *,
+    indexed: bool = False,
     lr: float = 0.5,
     max_iter: int = 100,
     history: int = 10,
     tol_grad: float = 1e-7,
     tol_change: float = 1e-10,
     tol_loss: float = 1e-12,
+    tol_stall: float = 0.0,
+    stall_window: int = 5,
     max_ls: int = 8,
+    max_failures: int = 3,
 ) -> LbfgsResult:
     """Minimise ``fun`` (B, D) -> (B,) row by row; returns the final points and losses.
 
-    A row stops when its gradient is below ``tol_grad``, its loss below ``tol_loss``, or an
-    iteration changes its loss or its point by less than ``tol_change``.
+    indexed: ``fun(x, idx)`` takes the rows ``idx`` (R,) of the batch, x (R, D), and returns
+    their (R,) losses; the line search then evaluates only the rows still searching, so rows
+    that have stopped cost nothing (with many starts, most stop long before the last).
+
+    A row stops when its gradient is below ``tol_grad``, its loss below ``tol_loss``, an
+    iteration changes its loss or its point by less than ``tol_change``, or (if ``tol_stall``
+    > 0) its last ``stall_window`` iterations lowered its loss by less than the fraction
+    ``tol_stall`` together, or ``max_failures`` line searches in a row end without a strong
+    Wolfe point. The batch stops when no row is left.
     """
     x = x0.detach().clone()
-    f, g = _value_and_grad(fun, x)
+    if indexed:
+        f, g = _rows_value_and_grad(fun, x, torch.ones_like(x[:, 0], dtype=torch.bool))
+    else:
+        f, g = _value_and_grad(fun, x)
     evals = 1
     active = (g.abs().amax(-1) > tol_grad) & (f > tol_loss)
     hist: list[tuple[Tensor, Tensor, Tensor]] = []
+    recent = [f]  # losses of the last stall_window iterations
+    failures = torch.zeros_like(f, dtype=torch.long)  # consecutive failed line searches
     it = 0
     for it in range(1, max_iter + 1):
         if not active.any():
@@ -104,7 +132,10 @@ def minimize(
         x_acc, f_acc, g_acc = x.clone(), f.clone(), g.clone()
         for _ in range(max_ls):
             x_try = torch.where(searching[:, None], x + t[:, None] * d, x_acc)
-            f_try, g_try = _value_and_grad(fun, x_try)
+            if indexed:
+                f_try, g_try = _rows_value_and_grad(fun, x_try, searching)
+            else:
+                f_try, g_try = _value_and_grad(fun, x_try)
             evals += 1
             armijo = f_try <= f + C1 * t * gtd
             slope = (g_try * d).sum(-1)
@@ -120,6 +151,8 @@ def minimize(
             hi = torch.where(searching & shrink, t, hi)
             lo = torch.where(searching & ~shrink, t, lo)
             t = torch.where(torch.isinf(hi), 2 * t, 0.5 * (lo + hi))
+        # a search that ends without a Wolfe point failed; three in a row stop the row
+        failures = torch.where(searching, failures + 1, 0)
         s, y = x_acc - x, g_acc - g
         sy = (s * y).sum(-1)
         rho = torch.where(sy > 1e-10, 1.0 / sy.clamp_min(1e-10), 0.0)
@@ -135,5 +168,11 @@ def minimize(
             & (moved > tol_change)
             & (change > tol_change)
             & (f > tol_loss)
+            & (failures < max_failures)
         )
+        recent.append(f)
+        if len(recent) > stall_window:
+            old = recent.pop(0)
+            if tol_stall > 0:
+                active &= (old - f) > tol_stall * old
     return LbfgsResult(x, f, it, evals)

@@ -8,7 +8,9 @@ design's curve exists, 0.1 where it stops short of the target's largest pressure
 held at the last value there), nothing beyond the target; it is divided by mean(alpha_t^2)
 so that tolerances do not depend on the target's scale. Stages: kappa_s log-spaced from
 kappa_start to kappa_end, each stage ``steps_per_stage`` L-BFGS steps of ``iterations``
-iterations (5 x 5 x 20, learning rate 0.5, strong Wolfe, by default).
+iterations (5 x 5 x 20, learning rate 0.5, strong Wolfe, by default) at most. A row stops
+early when its loss stalls (``tol_stall``) or its line search fails three times running;
+stopped rows are no longer evaluated, so many starts cost little more than the few slowest.
 """
 
 from __future__ import annotations
@@ -38,6 +40,10 @@ class RefineSettings:
     kappa_end: float = 1e5
     undershoot_weight: float = 0.1
     grid_points: int = 128
+    # A row leaves a stage once 5 iterations lower its loss by less than this fraction
+    # (1 %): 3-6x fewer evaluations, the same errors within 0.1 % on the built-in targets
+    # and on random realisable ones (benchmarks/bench_design.py).
+    tol_stall: float = 0.01
 
     def kappas(self) -> np.ndarray:
         return np.logspace(np.log10(self.kappa_start), np.log10(self.kappa_end), self.stages)
@@ -141,10 +147,19 @@ def refine(
     x = raw.detach().to(DTYPE)
     for kappa in rs.kappas():
 
-        def fun(z: Tensor, kappa: float = float(kappa)) -> Tensor:
+        def fun(z: Tensor, idx: Tensor, kappa: float = float(kappa)) -> Tensor:
             gamma, h = to_design(z, settings, hertz)
-            loss = masked_loss(gamma, h, settings, target, kappa, rs.undershoot_weight, physics)
+            loss = masked_loss(
+                gamma, h, settings, target.rows(idx), kappa, rs.undershoot_weight, physics
+            )
             return loss if extra_loss is None else loss + extra_loss(gamma, h, settings)
 
-        x = lbfgs.minimize(fun, x, lr=rs.lr, max_iter=rs.steps_per_stage * rs.iterations).x
+        x = lbfgs.minimize(
+            fun,
+            x,
+            indexed=True,
+            lr=rs.lr,
+            max_iter=rs.steps_per_stage * rs.iterations,
+            tol_stall=rs.tol_stall,
+        ).x
     return x

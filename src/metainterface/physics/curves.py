@@ -146,11 +146,6 @@ class _SweepFunction(torch.autograd.Function):
         # Layout (B, N, K): the sums over asperities (4 in the forward pass) then run over a
         # middle axis, several times faster than over a short last axis.
         x = delta[None, None, :] - h[:, :, None]
-        if smooth is not None:
-            # Far from contact softplus and its sigmoid underflow to subnormal numbers, which
-            # make every later operation on them ~100x slower on x86. From kappa_s x = -60 on
-            # the compression (1e-26 / kappa_s) is below the contact floor anyway: a = 0.
-            x = x.clamp_min(-60.0 / smooth)
         d = indentation(x, smooth)
         # Below this compression an asperity counts as out of contact (its area is ~1e-9 of
         # a cell's): d^2 stays a normal number, so every division stays finite in float32.

@@ -50,14 +50,21 @@ def indentation(gap: Tensor, smooth: float | None = None) -> Tensor:
     """
     if smooth is None:
         return torch.clamp_min(gap, 0.0)
-    return nnf.softplus(gap, beta=smooth, threshold=20.0)
+    return nnf.softplus(_tail(gap, smooth), beta=smooth, threshold=20.0)
 
 
 def engagement(gap: Tensor, smooth: float | None = None) -> Tensor:
     """d(indentation)/d(gap): the step 1[gap > 0], or the logistic sigmoid if ``smooth``."""
     if smooth is None:
         return (gap > 0).to(gap.dtype)
-    return torch.sigmoid(smooth * gap)
+    return torch.sigmoid(smooth * _tail(gap, smooth))
+
+
+def _tail(gap: Tensor, smooth: float) -> Tensor:
+    """The gap, floored at kappa_s gap = -60. Further out softplus and its sigmoid underflow
+    to subnormal numbers, which slow every later operation on them ~100x on x86; the
+    compression there (< 1e-26 / kappa_s) is below any contact threshold anyway."""
+    return gap.clamp_min(-60.0 / smooth)
 
 
 def contact_radius(gamma: Tensor, delta: Tensor, radius: float = 1.0) -> Tensor:
