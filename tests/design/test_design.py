@@ -162,3 +162,16 @@ def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, ca
     np.testing.assert_allclose(data["target"]["alpha"][-1], 0.06, rtol=1e-9)
     assert main([*args[:-4], "--modulus", "2mm"]) == 2  # a length is not a stress
     assert "modulus" in capsys.readouterr().err
+
+
+def test_fallback_multistart_for_targets_the_surrogate_misses():
+    # an exactly linear law is far from every training curve: the surrogate's refined design
+    # misses it, so the fallback multistart runs and the better design is kept
+    t = [builtin_target("linear"), builtin_target("saturating")]
+    pure = design(t, "surrogate", refine_settings=FAST)
+    multi = design(t[:1], "multistart", starts=4, seed=5, refine_settings=FAST)[0]
+    both = design(t, "surrogate", fallback=4, seed=5, refine_settings=FAST)
+    assert pure[0].error > 0.02 and pure[1].error < 0.02
+    assert both[0].error <= min(pure[0].error, multi.error) + 1e-12
+    assert both[0].fallback and both[0].method == "surrogate"
+    assert not both[1].fallback and both[1].error == pytest.approx(pure[1].error)

@@ -61,6 +61,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "prediction and keep the best (default 8; 0 = the paper's pure pipeline)",
     )
     p.add_argument(
+        "--fallback",
+        type=int,
+        default=50,
+        help="surrogate method: a target still missed by more than 2 %% after refinement also "
+        "gets a multistart with this many random starts, the better design kept (default 50; "
+        "0 = off)",
+    )
+    p.add_argument(
         "--physics",
         choices=("independent", "interacting"),
         default="independent",
@@ -142,6 +150,7 @@ def run(args: argparse.Namespace) -> int:
             extra_loss=extra,
             physics=args.physics,
             hedge=args.hedge if method == "surrogate" else 0,
+            fallback=args.fallback if method == "surrogate" else 0,
         )
         for method in methods
     ]

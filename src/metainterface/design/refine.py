@@ -16,7 +16,7 @@ stopped rows are no longer evaluated, so many starts cost little more than the f
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
@@ -44,6 +44,22 @@ class RefineSettings:
     # (1 %): 3-6x fewer evaluations, the same errors within 0.1 % on the built-in targets
     # and on random realisable ones (benchmarks/bench_design.py).
     tol_stall: float = 0.01
+    # then the winning row of each target gets this many more iterations at kappa_end,
+    # without the stall test (``polish``)
+    polish_iterations: int = 100
+
+    def polishing(self) -> RefineSettings:
+        """The settings of the polish: ``polish_iterations`` more iterations at kappa_end
+        without the stall test, the last stretch that the early stops skip, run on the
+        designs kept."""
+        return replace(
+            self,
+            stages=1,
+            kappa_start=self.kappa_end,
+            steps_per_stage=1,
+            iterations=self.polish_iterations,
+            tol_stall=0.0,
+        )
 
     def kappas(self) -> np.ndarray:
         return np.logspace(np.log10(self.kappa_start), np.log10(self.kappa_end), self.stages)

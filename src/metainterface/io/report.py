@@ -21,6 +21,15 @@ def pressure_check(design: Design, limit: float, e_star: float | None = None) ->
     return check_pressure(design, limit)
 
 
+def _origin(result: Any) -> str:
+    """Which start a DesignResult came from, in words (random starts numbered from 1)."""
+    if result.fallback:
+        return f"fallback multistart, random start {result.start + 1}"
+    if result.method != "surrogate":
+        return f"random start {result.start + 1}"
+    return "zero-shot" if result.start == 0 else f"hedge random start {result.start}"
+
+
 def write_design_outputs(
     folder: Path,
     result: Any,
@@ -41,11 +50,7 @@ def write_design_outputs(
         },
         "method": result.method,
         "physics": result.physics,
-        "winning_start": (
-            "zero-shot"
-            if result.method == "surrogate" and result.start == 0
-            else f"random start {result.start}"
-        ),
+        "winning_start": _origin(result),
         "relative_error": result.error,
         "zero_shot_error": result.initial_error,
         "seconds": result.seconds,
