@@ -28,15 +28,16 @@ def gap_scale(text: str) -> float | None:
     """--max-gap: a number in (0, 10] (units of Delta_max) or 'paper'."""
     if text == "paper":
         return None
+    # the model's own check, imported here (not at start-up) to keep `--help` free of torch
+    from metainterface.errors import MetainterfaceError
+    from metainterface.surrogate.model import check_max_gap
+
     try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not 0 < value <= 10:
+        return check_max_gap(float(text))
+    except (ValueError, MetainterfaceError):
         raise argparse.ArgumentTypeError(
             f"expected a number in (0, 10] (units of Delta_max) or 'paper', got {text!r}"
-        )
-    return value
+        ) from None
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -103,11 +103,13 @@ def minimize(
     ``tol_stall`` together, or ``max_failures`` line searches in a row end without a strong
     Wolfe point. The batch stops when no row is left.
     """
+
+    def evaluate(x: Tensor, rows: Tensor) -> tuple[Tensor, Tensor]:
+        """Loss and gradient at x; with ``indexed`` only the ``rows`` (B,) that are True."""
+        return _rows_value_and_grad(fun, x, rows) if indexed else _value_and_grad(fun, x)
+
     x = x0.detach().clone()
-    if indexed:
-        f, g = _rows_value_and_grad(fun, x, torch.ones_like(x[:, 0], dtype=torch.bool))
-    else:
-        f, g = _value_and_grad(fun, x)
+    f, g = evaluate(x, torch.ones_like(x[:, 0], dtype=torch.bool))
     evals = 1
     active = (g.abs().amax(-1) > tol_grad) & (f > tol_loss)
     hist: list[tuple[Tensor, Tensor, Tensor]] = []
@@ -132,10 +134,7 @@ def minimize(
         x_acc, f_acc, g_acc = x.clone(), f.clone(), g.clone()
         for _ in range(max_ls):
             x_try = torch.where(searching[:, None], x + t[:, None] * d, x_acc)
-            if indexed:
-                f_try, g_try = _rows_value_and_grad(fun, x_try, searching)
-            else:
-                f_try, g_try = _value_and_grad(fun, x_try)
+            f_try, g_try = evaluate(x_try, searching)
             evals += 1
             armijo = f_try <= f + C1 * t * gtd
             slope = (g_try * d).sum(-1)

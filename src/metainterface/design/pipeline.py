@@ -203,17 +203,12 @@ def _design(
     best = winner + torch.arange(len(targets)) * per_target
     if refine_designs and refine_settings.polish_iterations > 0:
         # the early stops cut the search short on every row; the winners get to finish
+        kept = rows.rows(best)
         raw_w = refine(
-            raw[best],
-            settings,
-            rows.rows(best),
-            refine_settings.polishing(),
-            hertz,
-            extra_loss,
-            physics,
+            raw[best], settings, kept, refine_settings.polishing(), hertz, extra_loss, physics
         )
         g_w, h_w = to_design(raw_w, settings, hertz)
-        err_w = relative_error(g_w, h_w, settings, rows.rows(best), physics)
+        err_w = relative_error(g_w, h_w, settings, kept, physics)
         better = err_w < err[best]
         gamma[best] = torch.where(better[:, None], g_w, gamma[best])
         h[best] = torch.where(better[:, None], h_w, h[best])

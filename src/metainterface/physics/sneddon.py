@@ -37,6 +37,15 @@ def log_kc(gamma: Tensor, radius: float = 1.0) -> Tensor:
     return log_kappa(gamma) - math.log(2.0) - (gamma - 1) * math.log(radius)
 
 
+def dlog_kc(gamma: Tensor, radius: float = 1.0) -> Tensor:
+    """d log(kappa c) / d gamma = psi(gamma/2 + 1)/2 - psi((gamma + 1)/2)/2 - log R."""
+    return (
+        0.5 * torch.special.digamma(gamma / 2 + 1)
+        - 0.5 * torch.special.digamma((gamma + 1) / 2)
+        - math.log(radius)
+    )
+
+
 def shape_constant(gamma: Tensor, radius: float = 1.0) -> Tensor:
     """c(gamma) = 1 / (2 R^(gamma - 1)) [R^(1 - gamma)]."""
     return 0.5 * radius ** (1 - gamma)

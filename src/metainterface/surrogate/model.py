@@ -28,6 +28,13 @@ DROPOUT = 0.1
 MAX_GAP = 1.1  # default gap scale G / Delta_max of new models (see the module docstring)
 
 
+def check_max_gap(max_gap: float | None) -> float | None:
+    """The gap scale G / Delta_max if it is None or in (0, 10]; a MetainterfaceError if not."""
+    if max_gap is not None and not (0 < max_gap <= 10):
+        raise MetainterfaceError(f"max_gap must be in (0, 10] (units of Delta_max), got {max_gap}")
+    return max_gap
+
+
 class InverseMLP(nn.Module):
     """Curve features (B, 2 n_steps + 2) -> raw outputs y in [0, 1]^(2N).
 
@@ -41,10 +48,7 @@ class InverseMLP(nn.Module):
         self, n_asperities: int = 9, n_steps: int = 128, max_gap: float | None = MAX_GAP
     ) -> None:
         super().__init__()
-        if max_gap is not None and not (0 < max_gap <= 10):
-            raise MetainterfaceError(
-                f"max_gap must be in (0, 10] (units of Delta_max), got {max_gap}"
-            )
+        check_max_gap(max_gap)
         self.n_asperities = n_asperities
         self.n_steps = n_steps
         self.max_gap = max_gap
