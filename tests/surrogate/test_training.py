@@ -13,7 +13,7 @@ from metainterface.physics import CellSettings
 from metainterface.surrogate.checkpoint import load_model
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.loss import LossWeights, weights_of
-from metainterface.surrogate.model import InverseMLP, outputs_to_design
+from metainterface.surrogate.model import Dropout, InverseMLP, outputs_to_design
 from metainterface.surrogate.schedules import Schedules
 from metainterface.surrogate.train import TrainConfig, read_metrics, train
 
@@ -29,8 +29,25 @@ def test_architecture_matches_table_a1():
         (256, 128),
         (128, 18),
     ]
-    assert sum(isinstance(x, torch.nn.Dropout) for x in m.net) == 2
+    assert [x.p for x in m.net if isinstance(x, Dropout)] == [0.1, 0.1]
     assert isinstance(m.net[-1], torch.nn.Sigmoid)
+
+
+def test_dropout_rate_scale_and_seed():
+    drop = Dropout(0.1)
+    x = torch.ones(400, 1001)  # numel not a multiple of 4
+    torch.manual_seed(3)
+    y = drop(x)
+    dropped = float((y == 0).float().mean())
+    assert dropped == pytest.approx(0.1, abs=0.003)  # 400k draws: sd 0.0005
+    assert torch.allclose(y[y != 0], torch.tensor(1 / 0.9))
+    torch.manual_seed(3)
+    assert torch.equal(drop(x), y)
+    assert not torch.equal(drop(x), y)
+    drop.eval()
+    assert drop(x) is x
+    with pytest.raises(ValueError, match="dropout probability"):
+        Dropout(1.0)
 
 
 def test_output_mapping_sorted_and_bounded():

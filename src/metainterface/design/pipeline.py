@@ -32,6 +32,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import alpha_at
 from metainterface.physics.forward import DEFAULT_PHYSICS, check_physics
+from metainterface.runtime import tune_allocator
 
 if TYPE_CHECKING:  # the surrogate (and its imports) load only when a design needs it
     from metainterface.surrogate.model import InverseMLP
@@ -113,6 +114,7 @@ def design(
     ``physics`` is the forward model the refinement optimises and the error is measured with
     ("independent", the paper's, or "interacting"); the surrogate was trained on the former.
     """
+    tune_allocator()
     common = dict(
         refine_designs=refine_designs,
         settings=settings,

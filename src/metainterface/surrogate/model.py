@@ -35,6 +35,30 @@ def check_max_gap(max_gap: float | None) -> float | None:
     return max_gap
 
 
+class Dropout(nn.Module):
+    """Inverted dropout (as nn.Dropout) whose mask comes from 16-bit random numbers.
+
+    nn.Dropout draws one Bernoulli variate per element, which took ~15 % of a training step
+    here; one 64-bit draw gives four 16-bit uniforms, four times fewer calls to the generator.
+    The drop probability is rounded to a multiple of 2^-16 (0.1 -> 0.100006).
+    """
+
+    def __init__(self, p: float) -> None:
+        super().__init__()
+        if not 0 <= p < 1:
+            raise ValueError(f"dropout probability must be in [0, 1), got {p}")
+        self.p = p
+        self._threshold = round(p * 65536) - 32768  # keep int16 values >= this
+
+    def forward(self, x: Tensor) -> Tensor:
+        if not self.training or self.p == 0:
+            return x
+        n = x.numel()
+        words = torch.randint(-(2**63), 2**63 - 1, ((n + 3) // 4,), device=x.device)
+        keep = words.view(torch.int16)[:n].view(x.shape) >= self._threshold
+        return x * keep * (1.0 / (1.0 - self.p))
+
+
 class InverseMLP(nn.Module):
     """Curve features (B, 2 n_steps + 2) -> raw outputs y in [0, 1]^(2N).
 
@@ -58,7 +82,7 @@ class InverseMLP(nn.Module):
         for i, hidden in enumerate(HIDDEN):
             layers += [nn.Linear(width, hidden), nn.BatchNorm1d(hidden), nn.GELU()]
             if i < len(HIDDEN) - 1:
-                layers.append(nn.Dropout(DROPOUT))
+                layers.append(Dropout(DROPOUT))
             width = hidden
         layers += [nn.Linear(width, 2 * n_asperities), nn.Sigmoid()]
         self.net = nn.Sequential(*layers)

@@ -33,6 +33,7 @@ from metainterface.io.csvfiles import write_columns
 from metainterface.io.provenance import provenance
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import curve
+from metainterface.runtime import tune_allocator
 from metainterface.surrogate.checkpoint import load_torch, save_model, save_torch
 from metainterface.surrogate.data import Split
 from metainterface.surrogate.loss import PAPER_WEIGHTS, LossWeights, param_loss, physics_loss
@@ -156,13 +157,17 @@ def train(
 ) -> TrainResult:
     """Train (or resume) a surrogate in ``out_dir``; returns a summary of the run."""
     config = config or TrainConfig()
+    tune_allocator()
     _check_sizes(train_split, val_split, config.batch_size)
     out = Path(out_dir)
     ckpt_path = out / "checkpoint.pt"
     torch.manual_seed(config.seed)
     model = InverseMLP(settings.n_asperities, settings.n_steps, config.max_gap)
     model.set_input_scaling(train_split.features)
-    opt = torch.optim.AdamW(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
+    # fused: one kernel for all parameters, half the optimiser time of the foreach default
+    opt = torch.optim.AdamW(
+        model.parameters(), lr=config.lr, weight_decay=config.weight_decay, fused=True
+    )
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=config.epochs)
     history: list[dict[str, float]] = []
     start, best, best_epoch, bad = 0, math.inf, -1, 0
