@@ -131,15 +131,17 @@ class _SweepFunction(torch.autograd.Function):
     """(gamma, anchored h) (B, N), Delta (K,) -> P*, alpha, S* (B, K), analytic backward.
 
     Autograd through the ~25 elementwise (B, K, N) operations of the sweep costs about twice
-    the forward pass and one node per operation; the closed-form derivatives below take half
-    the operations and no graph: the sweep's forward + backward runs about twice as fast,
-    which is most of the cost of an L-BFGS evaluation (in a training step the MLP
-    dominates). Per element, with x = Delta - h, d = <x>_+ (or softplus), e = dd/dx,
-    p = 1/gamma, a = (d / kc)^p, r = e / d and T = log a + d log kc / d gamma:
+    the forward pass and one node per operation; the closed-form derivatives below take
+    fewer operations and no graph. Per element, with x = Delta - h, d = <x>_+ (or softplus),
+    e = dd/dx, p = 1/gamma, a = (d / kc)^p, r = e / d and T = log a + d log kc / d gamma:
 
         da/dx = a p r,            da/dgamma = -a p T,
         F = sum 2 gamma/(gamma + 1) d a,  A2 = sum a^2,  DF = 2 sum a e,
         DA = 2 pi sum p a^2 r,    S* = DF / DA,  de/dx = kappa_s e (1 - e) (softplus only).
+
+    The backward sums each product of saved factors (u = a e, a^2 r, d a, ...) against the
+    upstream weights over K first and applies the per-asperity coefficients (functions of
+    gamma only) to the (B, N) sums: about 35 passes over (B, N, K) instead of 50.
     """
 
     @staticmethod
@@ -160,24 +162,23 @@ class _SweepFunction(torch.autograd.Function):
         e = pos if smooth is None else engagement(x, smooth)
         r = e / safe
         a2 = a * a
+        da = safe * a
+        u = a * e
+        a2r = a2 * r
         f_coef = (2.0 * gamma / (gamma + 1.0))[:, :, None]
-        force = (f_coef * safe * a).sum(1)
-        dforce = 2.0 * (a * e).sum(1)
-        darea = (2.0 * math.pi) * (inv_g * a2 * r).sum(1)
+        force = (f_coef * da).sum(1)
+        dforce = 2.0 * u.sum(1)
+        darea = (2.0 * math.pi) * (inv_g * a2r).sum(1)
         in_contact = darea > 0
         safe_darea = torch.where(in_contact, darea, 1.0)
         stiffness = dforce / safe_darea * in_contact
-        ctx.save_for_backward(
-            gamma, inv_g, f_coef, log_a, safe, a, e, r, stiffness, safe_darea, in_contact
-        )
+        ctx.save_for_backward(gamma, log_a, a2, da, u, a2r, e, r, stiffness, safe_darea, in_contact)
         ctx.smooth, ctx.radius, ctx.a_nom = smooth, radius, a_nom
         return force / a_nom, (math.pi / a_nom) * a2.sum(1), stiffness
 
     @staticmethod
     def backward(ctx, g_p, g_alpha, g_s):
-        (gamma, p, f_coef, log_a, safe, a, e, r, stiffness, safe_darea, in_contact) = (
-            ctx.saved_tensors
-        )
+        (gamma, log_a, a2, da, u, a2r, e, r, stiffness, safe_darea, in_contact) = ctx.saved_tensors
         smooth, a_nom = ctx.smooth, ctx.a_nom
         zeros = torch.zeros_like(stiffness)
         g_p = zeros if g_p is None else g_p
@@ -188,30 +189,38 @@ class _SweepFunction(torch.autograd.Function):
         c_a = (g_alpha * (2.0 * math.pi / a_nom))[:, None, :]  # d alpha = (pi / A) 2 a da
         c_df = (2.0 * g_s)[:, None, :]
         c_da = (-2.0 * math.pi * g_s * stiffness)[:, None, :]
+
+        def dot(x: Tensor, c: Tensor) -> Tensor:
+            return (x * c).sum(-1)  # (B, N)
+
+        p = 1.0 / gamma
+        f_coef = 2.0 * gamma / (gamma + 1.0)
+        df_coef = 2.0 / (gamma + 1.0) ** 2
         t = log_a + dlog_kc(gamma, ctx.radius)[:, :, None]  # T; always times a: no mask needed
-        pa = p * a
-        da_dx = pa * r
-        da_dg = -pa * t
-        q = pa * a * r  # p a^2 r, the summand of DA / (2 pi)
-        # d/dx: F: f_coef (e a + d da/dx) = f_coef a e (1 + p);  A2: 2 a da/dx;
-        # DF: 2 (e da/dx + a de/dx);  DA: q (2 p r - r + (de/dx) / e)
-        gx_df = e * da_dx
-        gx_da = q * ((2.0 * p - 1.0) * r)
-        if smooth is not None:
-            de = smooth * (1.0 - e)  # (de/dx) / e
-            gx_df = gx_df + a * e * de
-            gx_da = gx_da + q * de
-        g_x = (c_f * (f_coef * (1.0 + p))) * (a * e) + c_a * (a * da_dx) + c_df * gx_df
-        g_x = g_x + c_da * gx_da
-        # d/dgamma: F: d a df_coef + f_coef d da/dg;  A2: 2 a da/dg;  DF: 2 e da/dg;
-        # DA: -q p (1 + 2 T)
-        df_coef = (2.0 / (gamma + 1.0) ** 2)[:, :, None]
-        g_g = (
-            c_f * (safe * (df_coef * a + f_coef * da_dg))
-            + (c_a * a + c_df * e) * da_dg
-            - c_da * (q * p * (1.0 + 2.0 * t))
+        a2r_dot_da = dot(a2r, c_da)
+        # d/dx (the gradient of h is minus its sum over K):
+        #   F: f_coef a e (1 + p);  A2: 2 a da/dx = 2 p a^2 r;  DF: 2 e da/dx = 2 p u r;
+        #   DA: 2 pi p a^2 r (2 p - 1) r;  softplus: DF += 2 a de/dx, DA += 2 pi p a^2 de/dx
+        g_x = (
+            f_coef * (1.0 + p) * dot(u, c_f)
+            + p * dot(a2r, c_a)
+            + p * dot(u * r, c_df)
+            + p * (2.0 * p - 1.0) * dot(a2r * r, c_da)
         )
-        return g_g.sum(-1), -g_x.sum(-1), None, None, None, None
+        if smooth is not None:  # de/dx = kappa_s e (1 - e)
+            g_x = g_x + smooth * (
+                dot(u, c_df) - dot(u * e, c_df) + p * (a2r_dot_da - dot(a2r * e, c_da))
+            )
+        # d/dgamma: F: d a df_coef + f_coef d da/dg;  A2: 2 a da/dg;  DF: 2 e da/dg;
+        # DA: -2 pi p^2 a^2 r (1 + 2 T), with da/dg = -p a T
+        g_g = (
+            df_coef * dot(da, c_f)
+            - f_coef * p * dot(da * t, c_f)
+            - p * dot(a2 * t, c_a)
+            - p * dot(u * t, c_df)
+            - p * p * (a2r_dot_da + 2.0 * dot(a2r * t, c_da))
+        )
+        return g_g, -g_x, None, None, None, None
 
 
 def interp(xq: Tensor, xp: Tensor, *fps: Tensor) -> Tensor | tuple[Tensor, ...]:
@@ -232,6 +241,16 @@ def interp(xq: Tensor, xp: Tensor, *fps: Tensor) -> Tensor | tuple[Tensor, ...]:
         f0 = fp.gather(-1, idx - 1)
         out.append(f0 + w * (fp.gather(-1, idx) - f0))
     return out[0] if len(out) == 1 else tuple(out)
+
+
+def relative_l2(values: Tensor, reference: Tensor) -> Tensor:
+    """||values - reference||_2 / ||reference||_2 along the last axis: (B, M) -> (B,).
+
+    The relative curve error of the package, with alpha curves on the target's pressures.
+    """
+    return torch.linalg.vector_norm(values - reference, dim=-1) / torch.linalg.vector_norm(
+        reference, dim=-1
+    )
 
 
 def to_grid(sw: Sweep, n_steps: int) -> Curve:

