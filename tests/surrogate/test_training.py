@@ -70,6 +70,36 @@ def test_default_gap_scale_reaches_truncated_designs():
     assert float(h[0, 1]) > S.delta_max
 
 
+def test_curve_error_term():
+    # a linear law alpha = c P*: the relative error on the target's grid is known in closed form
+    from metainterface.physics.curves import Curve
+    from metainterface.surrogate.loss import CurveTargets, LossWeights, curve_error, physics_loss
+
+    n = 129
+    p_hat = torch.linspace(0, 1, n, dtype=torch.float64)[None]
+    target = CurveTargets(p_hat, torch.ones(1, n), torch.tensor([2.0]), torch.tensor([0.5]))
+
+    def linear(p_max: float, slope: float) -> Curve:
+        alpha = slope * p_hat * p_max
+        return Curve(alpha, torch.full_like(alpha, 1 / slope), torch.tensor([p_max]), alpha[:, -1])
+
+    same = linear(2.0, 0.25)
+    assert float(curve_error(same, target)) == pytest.approx(0.0, abs=1e-12)
+    # 10 % too much area at every pressure
+    assert float(curve_error(linear(2.0, 0.275), target)) == pytest.approx(0.1, rel=1e-9)
+    # stops at P* = 1 and is held at alpha = 0.25 beyond: the error is the integral's ratio
+    short = float(curve_error(linear(1.0, 0.25), target))
+    p = p_hat[0] * 2.0
+    expected = torch.linalg.vector_norm((0.25 * p - 0.25).clamp_min(0)) / torch.linalg.vector_norm(
+        0.25 * p
+    )
+    assert short == pytest.approx(float(expected), rel=1e-9)
+    # the term adds w_curve times the batch mean, and nothing with the paper's weights
+    base = physics_loss(short_curve := linear(1.0, 0.25), target, LossWeights())
+    with_term = physics_loss(short_curve, target, LossWeights(curve=5.0))
+    assert float(with_term - base) == pytest.approx(5.0 * short, rel=1e-9)
+
+
 def test_cli_defaults_match_train_config():
     from metainterface.cli.train import DEFAULTS
 

@@ -18,10 +18,11 @@ DEFAULTS = {
     "w_shape": 10.0,
     "w_grad": 1.0,
     "w_mag": 1000.0,
+    "w_curve": 300.0,
 }
 
 
-PAPER = {"shape": 10, "grad": 1, "mag": 10}
+PAPER = {"shape": 10, "grad": 1, "mag": 10, "curve": 0}
 
 
 def gap_scale(text: str) -> float | None:
@@ -76,6 +77,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         ("shape", "L1 of alpha_hat and S_hat"),
         ("grad", "L1 of the S_hat differences"),
         ("mag", "squared log10 errors of P*_max and alpha_max"),
+        ("curve", "relative curve error (what `evaluate` reports)"),
     ):
         p.add_argument(
             f"--w-{name}",
@@ -120,6 +122,7 @@ def run(args: argparse.Namespace) -> int:
         w_shape=args.w_shape,
         w_grad=args.w_grad,
         w_mag=args.w_mag,
+        w_curve=args.w_curve,
     )
     result = train(
         split_of(ds, "train"),

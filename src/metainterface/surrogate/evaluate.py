@@ -14,7 +14,7 @@ import numpy as np
 import torch
 
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import alpha_at, curve
+from metainterface.physics.curves import alpha_at, curve, relative_l2
 from metainterface.surrogate.data import Split
 from metainterface.surrogate.loss import PAPER_WEIGHTS, LossWeights
 from metainterface.surrogate.model import InverseMLP
@@ -50,12 +50,7 @@ def predict_split(
             )
             alpha_true = t.alpha_hat.double() * t.alpha_max.double()[:, None]
             alpha_pred, _ = alpha_at(gamma, h, settings, p_grid)
-            errs.append(
-                (
-                    torch.linalg.vector_norm(alpha_pred - alpha_true, dim=-1)
-                    / torch.linalg.vector_norm(alpha_true, dim=-1)
-                ).numpy()
-            )
+            errs.append(relative_l2(alpha_pred, alpha_true).numpy())
             c = curve(gamma, h, settings)
             lp.append(
                 (torch.log10(c.p_star_max) - torch.log10(t.p_star_max.double())).abs().numpy()
