@@ -175,3 +175,40 @@ def test_fallback_multistart_for_targets_the_surrogate_misses():
     assert both[0].error <= min(pure[0].error, multi.error) + 1e-12
     assert both[0].fallback and both[0].method == "surrogate"
     assert not both[1].fallback and both[1].error == pytest.approx(pure[1].error)
+
+
+def test_random_starts_are_nested_and_the_same_for_every_target():
+    from metainterface.design.pipeline import _starts
+
+    g8, h8 = _starts(8, 3, S, seed=5, hertz=False)
+    g3, h3 = _starts(3, 1, S, seed=5, hertz=False)
+    assert g8.shape == (24, 9)
+    torch.testing.assert_close(g8[:8], g8[16:])  # target 0 and target 2
+    torch.testing.assert_close(g8[:3], g3)  # the first 3 of 8 starts are the 3 starts
+    torch.testing.assert_close(h8[:3], h3)
+    assert float(g8.min()) >= S.gamma_min and float(g8.max()) <= S.gamma_max
+    assert float(h8.min()) >= 0 and float(h8.max()) <= S.delta_max
+
+
+def test_a_targets_multistart_design_does_not_depend_on_the_batch():
+    sat, bil = builtin_target("saturating"), builtin_target("bilinear")
+    both = design([sat, bil], "multistart", starts=3, refine_settings=FAST)
+    alone = design([bil], "multistart", starts=3, refine_settings=FAST)[0]
+    np.testing.assert_array_equal(both[1].gamma, alone.gamma)
+    assert both[1].error == alone.error
+
+
+def test_hedge_starts_jitter_the_zero_shot_design():
+    from metainterface.design.pipeline import JITTER_GAMMA, _hedge_starts, _starts
+
+    g0 = torch.full((2, 9), 3.0, dtype=torch.float64)
+    h0 = torch.linspace(0, 0.5 * S.delta_max, 9, dtype=torch.float64).expand(2, 9)
+    g, h = _hedge_starts(g0, h0, 5, S, seed=0)
+    assert g.shape == h.shape == (2, 5, 9)
+    # three jittered copies around the zero-shot design, then the first two random starts
+    spread = (g[:, :3] - 3.0).std()
+    assert 0.3 * JITTER_GAMMA * 2.2 < float(spread) < 3 * JITTER_GAMMA * 2.2
+    g_r, h_r = _starts(2, 1, S, seed=0, hertz=False)
+    torch.testing.assert_close(g[0, 3:], g_r)
+    torch.testing.assert_close(h[1, 3:], h_r)
+    assert float(h.min()) >= 0

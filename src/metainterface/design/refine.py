@@ -51,6 +51,11 @@ class RefineSettings:
     polish_exact: bool = True
     # the stages use the exact contact law instead of the softplus (set by ``polishing``)
     exact: bool = False
+    # L-BFGS stops a row whose gradient (max abs) or loss change falls below these; the
+    # polish turns both off, since a loss of 1e-8 (an error of 0.01 %) is a good design,
+    # not a converged one
+    tol_grad: float = 1e-7
+    tol_change: float = 1e-10
 
     def polishing(self) -> RefineSettings:
         """The settings of the polish: ``polish_iterations`` more iterations without the
@@ -67,6 +72,8 @@ class RefineSettings:
             iterations=self.polish_iterations,
             tol_stall=0.0,
             exact=self.polish_exact,
+            tol_grad=0.0,
+            tol_change=0.0,
         )
 
     def kappas(self) -> list[float | None]:
@@ -188,5 +195,7 @@ def refine(
             lr=rs.lr,
             max_iter=rs.steps_per_stage * rs.iterations,
             tol_stall=rs.tol_stall,
+            tol_grad=rs.tol_grad,
+            tol_change=rs.tol_change,
         ).x
     return x
