@@ -35,6 +35,7 @@ import torch
 from metainterface.physics import CellSettings, Design, interp, sweep
 from metainterface.physics.forward import alpha_at, alpha_at_loads
 from metainterface.physics.interaction import load_area_interacting, sweep_interacting
+from metainterface.runtime import tune_allocator
 
 RESULTS = Path(__file__).parent / "results"
 N_LOADS = 8
@@ -290,6 +291,7 @@ def timing(settings: CellSettings, threads: int) -> list[str]:
 
 
 def main() -> None:
+    tune_allocator()  # as the CLI, `design` and `train` run
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--grid", type=int, default=768, help="BEM grid M (multiple of 3)")
     ap.add_argument("--jobs", type=int, default=1, help="BEM processes per cell")
