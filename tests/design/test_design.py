@@ -212,3 +212,19 @@ def test_hedge_starts_jitter_the_zero_shot_design():
     torch.testing.assert_close(g[0, 3:], g_r)
     torch.testing.assert_close(h[1, 3:], h_r)
     assert float(h.min()) >= 0
+
+
+def test_a_start_on_the_bounds_can_still_move():
+    # gammas on both bounds and all gaps 0, what the surrogate outputs for the linear law:
+    # within 1e-4 of the bounds the sigmoid and softplus were flat and L-BFGS never moved
+    from metainterface.design.refine import TargetGrid, refine, relative_error
+
+    target = builtin_target("linear")
+    grid = TargetGrid.from_curves([(target.p_star, target.alpha)], 128)
+    gamma = torch.tensor([[1.8, 1.8, 1.8, 4.0, 4.0, 1.8, 4.0, 4.0, 4.0]], dtype=torch.float64)
+    h = torch.zeros(1, 9, dtype=torch.float64)
+    h[0, -1] = 1.1 * S.delta_max
+    before = float(relative_error(gamma, h, S, grid))
+    raw = refine(from_design(gamma, h, S), S, grid, FAST)
+    after = float(relative_error(*to_design(raw, S), S, grid))
+    assert before > 1.0 and after < 0.15

@@ -231,10 +231,9 @@ def _design(
         [(t.p_star, t.alpha) for t in targets], refine_settings.grid_points
     )
     rows = grid.rows(torch.arange(len(targets)).repeat_interleave(per_target))
-    # the starts as the refinement sees them (sorted, anchored, inside the bounds)
+    # the error of the starts as given (the refinement starts a little inside the bounds)
+    err0 = relative_error(gamma0, h0, settings, rows, physics)
     raw = from_design(gamma0, h0, settings, hertz)
-    gamma_i, h_i = to_design(raw, settings, hertz)
-    err0 = relative_error(gamma_i, h_i, settings, rows, physics)
     if refine_designs:
         raw = refine(raw, settings, rows, refine_settings, hertz, extra_loss, physics)
     gamma, h = to_design(raw.detach(), settings, hertz)
