@@ -57,8 +57,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--hedge",
         type=int,
         default=8,
-        help="surrogate method: also refine this many random starts beside the zero-shot "
-        "prediction and keep the best (default 8; 0 = the paper's pure pipeline)",
+        help="surrogate method: also refine this many starts beside the zero-shot prediction "
+        "(half jittered copies of it, half random) and keep the best (default 8; 0 = the "
+        "paper's pure pipeline)",
     )
     p.add_argument(
         "--fallback",

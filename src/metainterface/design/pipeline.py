@@ -140,9 +140,11 @@ def design(
 ) -> list[DesignResult]:
     """Design one cell per target with ``method``; returns one result per target.
 
-    ``hedge`` (surrogate method only): also refine that many random starts beside the zero-shot
-    prediction and keep the best; a guard for targets far from the training distribution
-    (e.g. exactly linear laws), at the cost of a larger batch. 0 is the paper's pipeline.
+    ``hedge`` (surrogate method only): also refine that many starts beside the zero-shot
+    prediction (:func:`_hedge_starts`: jittered copies of it, which find better neighbouring
+    optima, and random starts, a guard for targets far from the training distribution such
+    as exactly linear laws) and keep the best, at the cost of a larger batch. 0 is the
+    paper's pipeline.
 
     ``fallback`` (surrogate method only): a target whose refined design still misses it by
     more than ``fallback_error`` (relative curve error) is far from anything the surrogate
