@@ -190,11 +190,14 @@ def test_random_starts_are_nested_and_the_same_for_every_target():
     assert float(h8.min()) >= 0 and float(h8.max()) <= S.delta_max
 
 
-def test_a_targets_multistart_design_does_not_depend_on_the_batch():
+@pytest.mark.parametrize("method", ["multistart", "surrogate"])
+def test_a_targets_design_does_not_depend_on_the_batch(method):
     sat, bil = builtin_target("saturating"), builtin_target("bilinear")
-    both = design([sat, bil], "multistart", starts=3, refine_settings=FAST)
-    alone = design([bil], "multistart", starts=3, refine_settings=FAST)[0]
+    kw = dict(starts=3, hedge=2, refine_settings=FAST)
+    both = design([sat, bil], method, **kw)
+    alone = design([bil], method, **kw)[0]
     np.testing.assert_array_equal(both[1].gamma, alone.gamma)
+    np.testing.assert_array_equal(both[1].h, alone.h)
     assert both[1].error == alone.error
 
 
