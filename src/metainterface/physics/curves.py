@@ -18,6 +18,7 @@ from torch import Tensor
 
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.sneddon import dlog_kc, engagement, indentation, log_kc
+from metainterface.runtime import tune_allocator
 
 
 @dataclass(frozen=True)
@@ -162,17 +163,25 @@ class _SweepFunction(torch.autograd.Function):
         e = pos if smooth is None else engagement(x, smooth)
         r = e / safe
         a2 = a * a
-        da = safe * a
-        u = a * e
-        a2r = a2 * r
         f_coef = (2.0 * gamma / (gamma + 1.0))[:, :, None]
+        # With gradients the products are kept for the backward (5-20 % faster there);
+        # without (dataset curves), they are freed at once: a smaller working set.
+        keep = any(ctx.needs_input_grad[:2])
+        da = safe * a
         force = (f_coef * da).sum(1)
+        da = da if keep else None
+        u = a * e
         dforce = 2.0 * u.sum(1)
+        u = u if keep else None
+        a2r = a2 * r
         darea = (2.0 * math.pi) * (inv_g * a2r).sum(1)
         in_contact = darea > 0
         safe_darea = torch.where(in_contact, darea, 1.0)
         stiffness = dforce / safe_darea * in_contact
-        ctx.save_for_backward(gamma, log_a, a2, da, u, a2r, e, r, stiffness, safe_darea, in_contact)
+        if keep:
+            ctx.save_for_backward(
+                gamma, log_a, a2, da, u, a2r, e, r, stiffness, safe_darea, in_contact
+            )
         ctx.smooth, ctx.radius, ctx.a_nom = smooth, radius, a_nom
         return force / a_nom, (math.pi / a_nom) * a2.sum(1), stiffness
 
@@ -324,6 +333,7 @@ def curves_numpy(
     gamma, h: (S, N). Returns float32 arrays p_star_max (S,), alpha_max (S,),
     alpha_hat (S, n), stiffness_hat (S, n).
     """
+    tune_allocator()
     s, n = gamma.shape[0], settings.n_steps
     out = {
         "p_star_max": np.empty(s, np.float32),
