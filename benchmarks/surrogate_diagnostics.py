@@ -16,13 +16,9 @@ import numpy as np
 import torch
 
 from metainterface.data import load_dataset
-from metainterface.physics.curves import alpha_at, curve
+from metainterface.physics.curves import alpha_at, curve, relative_l2
 from metainterface.surrogate.checkpoint import default_model_path, load_model
 from metainterface.surrogate.data import split_of
-
-
-def rel(a: torch.Tensor, b: torch.Tensor) -> np.ndarray:
-    return (torch.linalg.vector_norm(a - b, dim=-1) / torch.linalg.vector_norm(b, dim=-1)).numpy()
 
 
 def reach(ds) -> None:
@@ -40,7 +36,9 @@ def reach(ds) -> None:
                 * torch.tensor(d.p_star_max, dtype=torch.float64)[:, None]
             )
             a, _ = alpha_at(torch.tensor(d.gamma, dtype=torch.float64), torch.tensor(h), s, p)
-            e = rel(a, torch.tensor(d.alpha_hat * d.alpha_max[:, None], dtype=torch.float64))
+            e = relative_l2(
+                a, torch.tensor(d.alpha_hat * d.alpha_max[:, None], dtype=torch.float64)
+            ).numpy()
             over = (gaps > cap * s.delta_max * (1 + 1e-9)).any(axis=1).mean()
             print(
                 f"{cap:.3f} | {cat} | {100 * over:.0f} % | "
@@ -55,7 +53,7 @@ def shape_and_magnitude(ds, model_path) -> None:
         feats, t, _, _ = test.rows(torch.arange(len(test)))
         g, h = model.design(feats, s)
         c = curve(g.double(), h.double(), s)
-    shape = rel(c.alpha_hat, t.alpha_hat.double())
+    shape = relative_l2(c.alpha_hat, t.alpha_hat.double()).numpy()
     la = (torch.log10(c.alpha_max) - torch.log10(t.alpha_max.double())).abs().numpy()
     lp = (torch.log10(c.p_star_max) - torch.log10(t.p_star_max.double())).abs().numpy()
     print(
