@@ -158,3 +158,24 @@ def test_load_path_chunks_are_contiguous_and_balanced():
         chunks = split_path(k, jobs, np.random.default_rng(k).uniform(0.1, 2, k))
         assert len(chunks) == min(k, jobs)
         np.testing.assert_array_equal(np.concatenate(chunks), np.arange(k))
+
+
+def test_target_errors_measure_bem_and_model_against_the_design_target(hertz):
+    import dataclasses
+
+    side = HERTZ.settings.cell_side
+    p = np.linspace(0.0, hertz.p_star[-1], 50)
+    alpha_hertz = math.pi * (3 * p * side**2 / 4) ** (2 / 3) / side**2  # closed form
+    assert hertz.target_errors() is None  # no target in the design
+
+    def with_target(alpha):
+        extras = {"target": {"p_star": p.tolist(), "alpha": alpha.tolist()}}
+        return dataclasses.replace(hertz, design=dataclasses.replace(HERTZ, extras=extras))
+
+    bem, model = with_target(alpha_hertz).target_errors()
+    assert model < 2e-3 and bem < 0.03  # the model is Hertz; the BEM is within its grid error
+    bem_off, model_off = with_target(1.1 * alpha_hertz).target_errors()
+    assert model_off == pytest.approx(1 / 11, rel=0.02)  # a target 10 % higher
+    assert bem_off > bem
+    summary = with_target(alpha_hertz).summary()
+    assert summary["target_error_bem"] == pytest.approx(bem)

@@ -132,4 +132,10 @@ def run(args: argparse.Namespace) -> int:
         + " model): "
         + ", ".join(f"{name} {100 * abs(r[upper]).max():.2f} %" for name, r in rel.items())
     )
+    errors = result.target_errors()
+    if errors is not None:
+        print(
+            f"error against the design's target at these loads: BEM {100 * errors[0]:.2f} %, "
+            f"{args.physics} model {100 * errors[1]:.2f} %"
+        )
     return 0

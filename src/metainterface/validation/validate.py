@@ -93,8 +93,38 @@ class ValidationResult:
         """Largest |rel_err| over all loads."""
         return float(np.abs(self.rel_err).max())
 
+    def target_errors(self) -> tuple[float, float] | None:
+        """Relative curve errors of BEM and model against the design's target, or None.
+
+        ||alpha - alpha_target||_2 / ||alpha_target||_2 over the loads within the target's
+        pressure range (the target interpolated there): (BEM, model). The BEM figure is what
+        the manufactured surface would show; the model one is the design's own claim, at the
+        same loads. None without a target or with no load inside its range.
+        """
+        target = design_target(self.design)
+        if target is None:
+            return None
+        p_t, a_t = target
+        inside = (self.p_star >= p_t[0]) & (self.p_star <= p_t[-1] * (1 + 1e-9))
+        if not inside.any():
+            return None
+        ref = np.interp(self.p_star[inside], p_t, a_t)
+        norm = float(np.linalg.norm(ref))
+        if norm == 0.0:
+            return None
+        return tuple(  # type: ignore[return-value]
+            float(np.linalg.norm(a[inside] - ref)) / norm
+            for a in (self.alpha_bem, self.alpha_model)
+        )
+
     def summary(self) -> dict[str, Any]:
-        """JSON-ready scalars."""
+        """JSON-ready scalars (with the target errors if the design carries a target)."""
+        errors = self.target_errors()
+        extra = (
+            {}
+            if errors is None
+            else {"target_error_bem": errors[0], "target_error_model": errors[1]}
+        )
         return {
             "name": self.name,
             "loads": len(self.p_star),
@@ -106,6 +136,7 @@ class ValidationResult:
             "max_local_pressure": float(self.p_max.max()),
             "max_residual": float(self.residual.max()),
             "bem_seconds": float(self.seconds.sum()),
+            **extra,
         }
 
 
