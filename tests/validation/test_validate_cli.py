@@ -22,7 +22,14 @@ def test_validate_writes_csv_figure_and_prints_the_error(tmp_path, capsys):
     args = ["validate", str(path), "--grid", "96", "--loads", "2", "--jobs", "1"]
     assert main([*args, "--out", str(out)]) == 0
     data = np.genfromtxt(out / "bem.csv", delimiter=",", names=True, skip_header=1)
-    assert data.dtype.names == ("p_star", "alpha_bem", "alpha_model", "rel_err", "p_max")
+    assert data.dtype.names == (
+        "p_star",
+        "alpha_bem",
+        "alpha_model",
+        "rel_err",
+        "p_max",
+        "alpha_bem_pixels",
+    )
     np.testing.assert_allclose(data["rel_err"], data["alpha_bem"] / data["alpha_model"] - 1)
     assert (out / "bem.csv").read_text().startswith("# {")
     assert (out / "validation.png").stat().st_size > 20_000

@@ -49,13 +49,15 @@ def require_tamaas() -> ModuleType:
 class LoadPath:
     """BEM measurements along a load path of K mean pressures.
 
-    alpha: (K,) fraction of grid points in contact. p_max: (K,) largest local p / E*.
-    asperity_alpha: (K, N) contact area of each asperity / A_nom (grid points in contact in
-    the asperity's lattice cell over M^2). residual: (K,) the solver's final error.
+    alpha: (K,) contact area fraction, edges placed to sub-pixel accuracy (``contact_area``).
+    alpha_pixels: (K,) fraction of grid points in contact (the plain count). p_max: (K,)
+    largest local p / E*. asperity_alpha: (K, N) contact area of each asperity / A_nom (its
+    lattice cell's share of ``alpha``). residual: (K,) the solver's final error.
     seconds: (K,) wall time of each solve. pressure: (M, M) p / E* at the last load.
     """
 
     alpha: np.ndarray
+    alpha_pixels: np.ndarray
     p_max: np.ndarray
     asperity_alpha: np.ndarray
     residual: np.ndarray
@@ -67,6 +69,7 @@ class LoadPath:
         """Join chunks of one path, in order; the pressure field is the last chunk's."""
         return LoadPath(
             alpha=np.concatenate([p.alpha for p in parts]),
+            alpha_pixels=np.concatenate([p.alpha_pixels for p in parts]),
             p_max=np.concatenate([p.p_max for p in parts]),
             asperity_alpha=np.concatenate([p.asperity_alpha for p in parts]),
             residual=np.concatenate([p.residual for p in parts]),
@@ -84,6 +87,50 @@ def _quiet(tm: ModuleType) -> Iterator[None]:
         yield
     finally:
         tm.set_log_level(level)
+
+
+def contact_area(
+    pressure: np.ndarray, owner: np.ndarray, n_asperities: int
+) -> tuple[float, np.ndarray, float]:
+    """Contact area of a periodic M x M pressure field, with edges to sub-pixel accuracy.
+
+    pressure: (M, M) p / E* (in contact where > 0); owner: (M * M,) or (M, M) asperity
+    index of each grid point. Returns (alpha, per-asperity alpha (N,), pixel alpha), all as
+    fractions of the cell.
+
+    Counting grid points in contact puts every contact edge half-way between the last point
+    in contact and the first one out, which reads alpha high by up to a few % at 768 x 768
+    (an edge's offset of ~0.5 grid step on a contact radius of 20-60 steps; worse and noisy
+    for the first contacts). Near the edge of a smooth contact the pressure falls as the
+    square root of the distance to the edge, so p^2 is linear in it: along each grid line,
+    p^2 at an edge point and at its neighbour inside extrapolate to zero at the edge, a
+    fraction t = p_e^2 / (p_in^2 - p_e^2) of a step beyond the edge point (clipped to
+    [0, 1]; 0.5, the count's value, where a run is one point long or p does not rise
+    inwards). The area is the count plus sum (t - 1/2) over the edge points of the rows,
+    averaged with the same along the columns. Against Sneddon's closed forms for single
+    power-law asperities (gamma 1.8-4, contact radii 6-70 steps) this takes the error of the
+    count from up to +11 % to within ~0.5 % (tests/validation/test_bem.py).
+    """
+    p = np.asarray(pressure, dtype=np.float64)
+    owner = np.asarray(owner).ravel()
+    m = p.shape[0]
+    inside = p > 0
+    q = np.where(inside, p, 0.0) ** 2
+    count = np.bincount(owner[inside.ravel()], minlength=n_asperities).astype(np.float64)
+    shift = np.zeros(n_asperities)
+    for axis in (0, 1):
+        for step in (1, -1):
+            # edge points: in contact, the next point along +step is not
+            edge = inside & ~np.roll(inside, -step, axis=axis)
+            q_in = np.roll(q, step, axis=axis)  # the neighbour on the inner side
+            rising = edge & (q_in > q)
+            t = np.full(p.shape, 0.5)
+            t[rising] = np.clip(q[rising] / (q_in[rising] - q[rising]), 0.0, 1.0)
+            shift += np.bincount(
+                owner, weights=np.where(edge, t - 0.5, 0.0).ravel(), minlength=n_asperities
+            )
+    per = (count + 0.5 * shift) / (m * m)  # the mean of the row and the column estimates
+    return float(per.sum()), per, float(count.sum()) / (m * m)
 
 
 def solve_path(
@@ -113,7 +160,7 @@ def solve_path(
     surface = np.ascontiguousarray(heights, dtype=np.float64)  # Tamaas keeps a reference
     m = surface.shape[0]
     k = len(loads)
-    alpha, p_max, residual, seconds = (np.empty(k) for _ in range(4))
+    alpha, alpha_pixels, p_max, residual, seconds = (np.empty(k) for _ in range(5))
     per = np.empty((k, n_asperities))
     owner_flat = np.asarray(owner).ravel()
     with _quiet(tm):
@@ -140,16 +187,13 @@ def solve_path(
                     f"after {max_iter} iterations"
                 )
             traction = model.traction.reshape(m, m)
-            contact = (traction > 0).ravel()
-            counts = np.bincount(owner_flat[contact], minlength=n_asperities)
-            per[i] = counts / (m * m)
-            alpha[i] = counts.sum() / (m * m)
+            alpha[i], per[i], alpha_pixels[i] = contact_area(traction, owner_flat, n_asperities)
             p_max[i] = float(traction.max())
             residual[i] = err
             if report is not None:
                 report(1)
         pressure = np.array(model.traction.reshape(m, m), copy=True)
-    return LoadPath(alpha, p_max, per, residual, seconds, pressure)
+    return LoadPath(alpha, alpha_pixels, p_max, per, residual, seconds, pressure)
 
 
 # --- processes ---------------------------------------------------------------------------
