@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
@@ -327,12 +327,7 @@ def alpha_at(
         if smooth is not None:
             raise ValueError("exact alpha_at is for the exact contact law (smooth=None)")
         sw, p_max = at_pressures(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
-        # One Newton step in alpha at the converged, detached Delta: its value is alpha(p)
-        # to second order, and its gradient is the implicit one, d alpha/d theta at fixed
-        # p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
-        ok = (sw.stiffness > 0) & (p_star < p_max[:, None])
-        inv_s = torch.where(ok, 1.0 / torch.where(ok, sw.stiffness, 1.0), 0.0).detach()
-        return sw.alpha + (p_star - sw.p_star) * inv_s, p_max
+        return sw.alpha, p_max
     sw = (sweep_fn or sweep)(gamma, h, settings, smooth=smooth, n_delta=n_delta)
     zero = torch.zeros_like(sw.p_star[:, :1])
     p = torch.cat([zero, sw.p_star], dim=-1)
@@ -360,9 +355,9 @@ def at_pressures(
 
     Delta (B, M), found without gradients by Newton steps from the linear interpolation of
     an ``n_delta``-sample sweep and kept inside the sweep's bracket of the root (P* grows
-    with Delta), is ``Sweep.delta``; P*, alpha and S* there carry gradients in gamma and h
-    at fixed Delta. ``sweep_fn`` (default :func:`sweep`) must accept a (B, M) ``delta`` and
-    give ``load_slope``.
+    with Delta), is ``Sweep.delta``; P* and S* there carry gradients in gamma and h at
+    fixed Delta, alpha is alpha(p_star) with its gradient at fixed pressure. ``sweep_fn``
+    (default :func:`sweep`) must accept a (B, M) ``delta`` and give ``load_slope``.
     """
     fn = sweep_fn or sweep
     with torch.no_grad():
@@ -389,7 +384,12 @@ def at_pressures(
         move = torch.where(~done & (slope > 0), resid / torch.where(slope > 0, slope, 1.0), 0.0)
         delta = torch.minimum(torch.maximum(delta - move, lo), hi)
         sw = fn(gamma, h, settings, delta=delta)
-    return sw, p_max
+    # One Newton step in alpha at the converged, detached Delta: its value is alpha(p) to
+    # second order in the residual, and its gradient is the implicit one, d alpha/d theta
+    # at fixed p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
+    ok = (sw.stiffness > 0) & ~beyond
+    inv_s = torch.where(ok, 1.0 / torch.where(ok, sw.stiffness, 1.0), 0.0).detach()
+    return replace(sw, alpha=sw.alpha + (p_star - sw.p_star) * inv_s), p_max
 
 
 def curves_numpy(
