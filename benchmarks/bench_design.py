@@ -17,23 +17,19 @@ import numpy as np
 import torch
 
 from metainterface.design import builtin_target, design
-from metainterface.design.targets import Target
-from metainterface.physics import CellSettings, sweep
+from metainterface.design.targets import Target, design_targets
+from metainterface.physics import CellSettings
 
 
 def realisable_targets(count: int, seed: int = 7) -> list[Target]:
-    """Curves of random cells (gamma uniform in the bounds, h uniform in [0, Delta_max])."""
+    """Exact curves of random cells (gamma uniform in the bounds, h uniform in [0, Delta_max])."""
     s = CellSettings()
     gen = torch.Generator().manual_seed(seed)
     g = s.gamma_min + (s.gamma_max - s.gamma_min) * torch.rand(
         count, 9, generator=gen, dtype=torch.float64
     )
     h = s.delta_max * torch.rand(count, 9, generator=gen, dtype=torch.float64)
-    sw = sweep(g, h, s, n_delta=256)
-    return [
-        Target(f"random{i}", sw.p_star[i].numpy(), sw.alpha[i].numpy(), sw.stiffness[i].numpy())
-        for i in range(count)
-    ]
+    return design_targets([f"random{i}" for i in range(count)], g, h, s)
 
 
 def main() -> None:

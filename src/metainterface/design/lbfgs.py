@@ -154,7 +154,10 @@ def minimize(
         failures = torch.where(searching, failures + 1, 0)
         s, y = x_acc - x, g_acc - g
         sy = (s * y).sum(-1)
-        rho = torch.where(sy > 1e-10, 1.0 / sy.clamp_min(1e-10), 0.0)
+        # a pair counts where its curvature is positive, relative to the step and gradient
+        # change (scale-free: a polish at losses of 1e-8 has both tiny)
+        valid = sy > 1e-10 * s.norm(dim=-1) * y.norm(dim=-1)
+        rho = torch.where(valid, 1.0 / torch.where(valid, sy, 1.0), 0.0)
         hist.append((s, y, rho))
         if len(hist) > history:
             hist.pop(0)

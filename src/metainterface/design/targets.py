@@ -11,6 +11,9 @@ default cell (N = 9, R = 1, Delta_max = R/50, gamma in [1.8, 4]):
   jumps when the second group engages.
 * ``linear``: alpha = 25 P* for P* in [0, 0.002], synthetic (a constant friction coefficient
   over the whole range); 128 points.
+
+The two design targets are sampled exactly at ``DESIGN_TARGET_POINTS`` uniform pressures
+(:func:`design_targets`), so their own designs meet them to round-off.
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ import torch
 from metainterface.errors import MetainterfaceError
 from metainterface.io.csvfiles import read_columns
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import sweep
+from metainterface.physics.curves import at_pressures, sweep
 
 
 @dataclass(frozen=True)
@@ -49,19 +52,53 @@ class Target:
         return float(self.p_star[-1])
 
 
+#: Pressures at which design targets are sampled: 127 * 8 + 1 uniform points, so that the
+#: refinement's 128-point grid (RefineSettings.grid_points) falls on every 8th and a design
+#: is compared with its target's exact values there; other grids interpolate finely.
+DESIGN_TARGET_POINTS = 127 * 8 + 1
+
+
+def design_targets(
+    names: list[str],
+    gamma: torch.Tensor,
+    h: torch.Tensor,
+    settings: CellSettings | None = None,
+    source: str = "",
+    points: int = DESIGN_TARGET_POINTS,
+) -> list[Target]:
+    """The exact curves of (B, N) designs (h in units of R) as targets, one per name: alpha
+    and S* at ``points`` uniform pressures on [0, P*_max], exact to round-off (the pressure
+    is solved for, :func:`~metainterface.physics.curves.at_pressures`)."""
+    s = settings or CellSettings()
+    gamma, h = gamma.to(torch.float64), h.to(torch.float64)
+    if len(names) != gamma.shape[0] or gamma.shape != h.shape or gamma.dim() != 2:
+        raise MetainterfaceError(
+            f"design_targets: {len(names)} names for gamma {tuple(gamma.shape)}, "
+            f"h {tuple(h.shape)}; need one (N,) row of each per name"
+        )
+    with torch.no_grad():
+        p_max = sweep(gamma, h, s, n_delta=2).p_star[:, -1:]
+        p = torch.linspace(0.0, 1.0, points, dtype=torch.float64)[None] * p_max
+        p[:, -1] = p_max[:, 0]  # exactly P*_max: the last point is Delta_max itself
+        sw, _ = at_pressures(gamma, h, s, p)
+    return [
+        Target(
+            name,
+            p[i].numpy(),
+            sw.alpha[i].numpy(),
+            sw.stiffness[i].numpy(),
+            source,
+            {"gamma": gamma[i].tolist(), "h": h[i].tolist()},
+        )
+        for i, name in enumerate(names)
+    ]
+
+
 def _design_target(name: str, gamma: list[float], h_frac: list[float], source: str) -> Target:
     s = CellSettings()
     g = torch.tensor([gamma], dtype=torch.float64)
     h = torch.tensor([h_frac], dtype=torch.float64) * s.delta_max
-    sw = sweep(g, h, s, n_delta=256)
-    return Target(
-        name,
-        sw.p_star[0].numpy(),
-        sw.alpha[0].numpy(),
-        sw.stiffness[0].numpy(),
-        source,
-        {"gamma": gamma, "h": h[0].tolist()},
-    )
+    return design_targets([name], g, h, s, source)[0]
 
 
 def _saturating() -> Target:

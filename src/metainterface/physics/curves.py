@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
@@ -25,13 +25,16 @@ from metainterface.runtime import tune_allocator
 class Sweep:
     """The cell's response sampled along the Delta sweep.
 
-    delta: (K,) global indentation [length]; p_star, alpha, stiffness: (B, K).
+    delta: (K,) global indentation [length], or (B, K) for a sweep of its own per design;
+    p_star, alpha, stiffness: (B, K). load_slope: (B, K) dP*/dDelta [1/length] where the
+    model gives it (None otherwise), no gradient: for Newton steps on Delta.
     """
 
     delta: Tensor
     p_star: Tensor
     alpha: Tensor
     stiffness: Tensor
+    load_slope: Tensor | None = None
 
 
 @dataclass(frozen=True)
@@ -114,7 +117,7 @@ def sweep(
 
     gamma, h: (B, N) shape exponents and height offsets [units of R]; heights are anchored
     (min h -> 0) first. smooth: softplus steepness kappa_s [1/R], None for the exact bracket.
-    delta: optional (K,) sweep to use instead of the uniform one.
+    delta: optional (K,) sweep to use instead of the uniform one, or (B, K), one per design.
     Returns P*, alpha and the analytic S* = sum dP_i/dDelta / sum dalpha_i/dDelta, finite at
     engagement (0 before contact; an engaging gamma > 2 asperity drives it towards 0).
     Differentiable in gamma and h through a hand-written backward (:class:`_SweepFunction`).
@@ -122,14 +125,17 @@ def sweep(
     dtype = gamma.dtype
     if delta is None:
         delta = delta_grid(settings, n_delta, dtype=dtype).to(gamma.device)
-    p_star, alpha, stiffness = _SweepFunction.apply(
+    p_star, alpha, stiffness, load_slope = _SweepFunction.apply(
         gamma, anchor(h), delta, smooth, settings.radius, settings.nominal_area
     )
-    return Sweep(delta=delta, p_star=p_star, alpha=alpha, stiffness=stiffness)
+    return Sweep(
+        delta=delta, p_star=p_star, alpha=alpha, stiffness=stiffness, load_slope=load_slope
+    )
 
 
 class _SweepFunction(torch.autograd.Function):
-    """(gamma, anchored h) (B, N), Delta (K,) -> P*, alpha, S* (B, K), analytic backward.
+    """(gamma, anchored h) (B, N), Delta (K,) or (B, K) -> P*, alpha, S*, dP*/dDelta (B, K),
+    analytic backward (dP*/dDelta is not differentiable).
 
     Autograd through the ~25 elementwise (B, K, N) operations of the sweep costs about twice
     the forward pass and one node per operation; the closed-form derivatives below take
@@ -149,7 +155,7 @@ class _SweepFunction(torch.autograd.Function):
     def forward(ctx, gamma, h, delta, smooth, radius, a_nom):
         # Layout (B, N, K): the sums over asperities (4 in the forward pass) then run over a
         # middle axis, several times faster than over a short last axis.
-        x = delta[None, None, :] - h[:, :, None]
+        x = (delta[None, None, :] if delta.dim() == 1 else delta[:, None, :]) - h[:, :, None]
         d = indentation(x, smooth)
         # Below this compression an asperity counts as out of contact (its area is ~1e-9 of
         # a cell's): d^2 stays a normal number, so every division stays finite in float32.
@@ -183,10 +189,12 @@ class _SweepFunction(torch.autograd.Function):
                 gamma, log_a, a2, da, u, a2r, e, r, stiffness, safe_darea, in_contact
             )
         ctx.smooth, ctx.radius, ctx.a_nom = smooth, radius, a_nom
-        return force / a_nom, (math.pi / a_nom) * a2.sum(1), stiffness
+        load_slope = dforce / a_nom
+        ctx.mark_non_differentiable(load_slope)
+        return force / a_nom, (math.pi / a_nom) * a2.sum(1), stiffness, load_slope
 
     @staticmethod
-    def backward(ctx, g_p, g_alpha, g_s):
+    def backward(ctx, g_p, g_alpha, g_s, _g_slope):
         (gamma, log_a, a2, da, u, a2r, e, r, stiffness, safe_darea, in_contact) = ctx.saved_tensors
         smooth, a_nom = ctx.smooth, ctx.a_nom
         zeros = torch.zeros_like(stiffness)
@@ -304,17 +312,84 @@ def alpha_at(
     smooth: float | None = None,
     n_delta: int | None = None,
     sweep_fn: Callable[..., Sweep] | None = None,
+    exact: bool = False,
 ) -> tuple[Tensor, Tensor]:
     """alpha of (B, N) designs at given pressures p_star (B, M), and P*_max (B,).
 
     Beyond a design's P*_max its alpha is held at the last value (the convention of the
     relative curve error and of the refinement's undershoot term). ``sweep_fn`` picks the
-    forward model (default: the independent one, :func:`sweep`).
+    forward model (default: the independent one, :func:`sweep`). By default alpha is
+    interpolated linearly in a sweep of ``n_delta`` samples (settings.n_steps); ``exact``
+    solves P*(Delta) = p_star instead (:func:`at_pressures`, exact law only; ``sweep_fn``
+    must give ``load_slope`` and S*) and is exact to round-off, with exact gradients.
     """
+    if exact:
+        if smooth is not None:
+            raise ValueError("exact alpha_at is for the exact contact law (smooth=None)")
+        sw, p_max = at_pressures(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
+        return sw.alpha, p_max
     sw = (sweep_fn or sweep)(gamma, h, settings, smooth=smooth, n_delta=n_delta)
     zero = torch.zeros_like(sw.p_star[:, :1])
     p = torch.cat([zero, sw.p_star], dim=-1)
     return interp(p_star, p, torch.cat([zero, sw.alpha], dim=-1)), p[:, -1]
+
+
+#: Newton steps at most in :func:`at_pressures`, and its tolerance on |P*(Delta) - p| / p
+#: (alpha then errs by ~1e-20 after the final step in alpha). From the interpolated start
+#: 1-3 steps reach it: P*(Delta) of independent asperities is convex, so the iterates
+#: approach the root from above after the first.
+NEWTON_STEPS, NEWTON_TOL = 8, 1e-10
+
+
+def at_pressures(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_star: Tensor,
+    *,
+    n_delta: int | None = None,
+    sweep_fn: Callable[..., Sweep] | None = None,
+) -> tuple[Sweep, Tensor]:
+    """The exact-law response of (B, N) designs where P*(Delta) equals p_star (B, M), and
+    P*_max (B,) (detached); Delta = Delta_max where p_star >= P*_max.
+
+    Delta (B, M), found without gradients by Newton steps from the linear interpolation of
+    an ``n_delta``-sample sweep and kept inside the sweep's bracket of the root (P* grows
+    with Delta), is ``Sweep.delta``; P* and S* there carry gradients in gamma and h at
+    fixed Delta, alpha is alpha(p_star) with its gradient at fixed pressure. ``sweep_fn``
+    (default :func:`sweep`) must accept a (B, M) ``delta`` and give ``load_slope``.
+    """
+    fn = sweep_fn or sweep
+    with torch.no_grad():
+        coarse = fn(gamma, h, settings, n_delta=n_delta)
+        knots = coarse.delta.expand_as(coarse.p_star)
+        p_max = coarse.p_star[:, -1]
+        beyond = p_star >= p_max[:, None]
+        delta = interp(p_star, coarse.p_star, knots)
+        step = float(knots[0, 1] - knots[0, 0])
+        lo, hi = (delta - step).clamp_min(0.0), (delta + step).clamp_max(settings.delta_max)
+        tol = max(NEWTON_TOL, 64 * torch.finfo(p_star.dtype).eps) * p_star.abs()
+    # evaluated with gradients (cheap to keep): the last evaluation is the result
+    sw = fn(gamma, h, settings, delta=delta)
+    if sw.load_slope is None:
+        raise ValueError("at_pressures needs a sweep_fn that gives load_slope")
+    for _ in range(NEWTON_STEPS):
+        resid = torch.where(beyond, 0.0, sw.p_star.detach() - p_star)
+        # converged points stay put: each point's Delta, and so a design's result, does
+        # not depend on the other rows of the batch
+        done = resid.abs() <= tol
+        if bool(done.all()):
+            break
+        slope = sw.load_slope
+        move = torch.where(~done & (slope > 0), resid / torch.where(slope > 0, slope, 1.0), 0.0)
+        delta = torch.minimum(torch.maximum(delta - move, lo), hi)
+        sw = fn(gamma, h, settings, delta=delta)
+    # One Newton step in alpha at the converged, detached Delta: its value is alpha(p) to
+    # second order in the residual, and its gradient is the implicit one, d alpha/d theta
+    # at fixed p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
+    ok = (sw.stiffness > 0) & ~beyond
+    inv_s = torch.where(ok, 1.0 / torch.where(ok, sw.stiffness, 1.0), 0.0).detach()
+    return replace(sw, alpha=sw.alpha + (p_star - sw.p_star) * inv_s), p_max
 
 
 def curves_numpy(

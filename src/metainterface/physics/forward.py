@@ -112,14 +112,21 @@ def alpha_at(
     physics: str = DEFAULT_PHYSICS,
     smooth: float | None = None,
     n_delta: int | None = None,
+    exact: bool = False,
 ) -> tuple[Tensor, Tensor]:
     """``curves.alpha_at`` under a choice of model: alpha (B, M) at p_star (B, M), P*_max (B,).
 
-    Same convention (alpha held at its last value beyond P*_max); the interacting model is
-    run without its stiffness tangent, which alpha does not need (~25 % cheaper).
+    Same convention (alpha held at its last value beyond P*_max). Interpolated, the
+    interacting model is run without its stiffness tangent, which alpha does not need (~25 %
+    cheaper); ``exact`` (exact law only) solves P*(Delta) = p_star, which needs it.
     """
-    fn = sweep if check_physics(physics) == "independent" else _load_area_sweep
-    return curves.alpha_at(gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta, sweep_fn=fn)
+    if check_physics(physics) == "independent":
+        fn = sweep
+    else:
+        fn = sweep_interacting if exact else _load_area_sweep
+    return curves.alpha_at(
+        gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta, sweep_fn=fn, exact=exact
+    )
 
 
 def _load_area_sweep(

@@ -246,13 +246,15 @@ def sweep_interacting(
     """The cell response along Delta with elastic interaction; the contract of ``sweep``.
 
     gamma, h: (B, N) [h in units of R], anchored (min h -> 0). smooth: softplus steepness
-    [1/R], None for the exact bracket. n_delta / delta: the (K,) sweep, as in ``sweep``.
+    [1/R], None for the exact bracket. n_delta / delta: the (K,) or (B, K) sweep, as in
+    ``sweep``.
     curvature: add the neighbours' curvature term b (default ``CURVATURE``: off, the tip
     shift only; see the module docstring). kernel: explicit matrices instead
     (``interaction(...)``, whose curvature may be None; ``.scaled(0)`` gives ``sweep``
     exactly); overrides ``curvature``.
     iterations: Newton sweeps, each one power-law evaluation of the (N, B, K) state.
-    Returns delta (K,) and P*, alpha, S* = dP*/dalpha, (B, K); differentiable throughout.
+    Returns delta and P*, alpha, S* = dP*/dalpha, (B, K), differentiable throughout, and
+    dP*/dDelta (B, K, detached).
     """
     return _solve(gamma, h, settings, smooth, n_delta, delta, kernel, iterations, curvature)[0]
 
@@ -356,7 +358,8 @@ def _solve(
         tgt = indentation(gap, smooth)
         return tgt, (torch.sign(tgt) if exact else engagement(gap, smooth))
 
-    gap0 = delta[None, None, :] - anchor(h).T[:, :, None]  # (N, B, K)
+    sweep_axis = delta[None, None, :] if delta.dim() == 1 else delta[None]  # (K,) or (B, K)
+    gap0 = sweep_axis - anchor(h).T[:, :, None]  # (N, B, K)
     d = indentation(gap0, smooth)
     b = None
     eng = target(gap0)[1] if iterations < 1 else None
@@ -410,5 +413,7 @@ def _solve(
     spread = gam * safe if b is None else torch.addcmul(gam * safe, b, a2, value=4.0)
     darea = (2.0 * math.pi) * (a2 * t / spread).sum(0)
     in_contact = darea > 0
-    stiffness = torch.where(in_contact, dforce.sum(0) / torch.where(in_contact, darea, 1.0), 0.0)
-    return Sweep(delta=delta, p_star=p_star, alpha=alpha, stiffness=stiffness), per
+    dforce = dforce.sum(0)
+    stiffness = torch.where(in_contact, dforce / torch.where(in_contact, darea, 1.0), 0.0)
+    slope = (dforce / a_nom).detach()
+    return Sweep(delta, p_star, alpha, stiffness, load_slope=slope), per
