@@ -341,6 +341,31 @@ def alpha_at(
 NEWTON_STEPS, NEWTON_TOL = 8, 1e-10
 
 
+def _load_and_slope(
+    gamma: Tensor, h: Tensor, settings: CellSettings, *, delta: Tensor, **_: object
+) -> Sweep:
+    """P* and dP*/dDelta of the independent model at per-design Deltas (B, M), nothing else.
+
+    The Newton steps of :func:`at_pressures` need only these: ~15 tensor operations without
+    a graph, where :func:`sweep` takes ~35 and keeps its products for a backward. alpha and
+    S* are left None-like (zeros) and are not to be used.
+    """
+    x = delta[:, None, :] - anchor(h)[:, :, None]  # (B, N, M)
+    d = torch.relu(x)
+    floor = _contact_floor(gamma.dtype)
+    inv_g = (1.0 / gamma)[:, :, None]
+    a = torch.exp(
+        inv_g * (torch.log(d.clamp_min(floor)) - log_kc(gamma, settings.radius)[:, :, None])
+    )
+    a = a * (d > floor)
+    f_coef = (2.0 * gamma / (gamma + 1.0))[:, :, None]
+    a_nom = settings.nominal_area
+    p_star = (f_coef * d * a).sum(1) / a_nom
+    zeros = torch.zeros_like(p_star)
+    # dF/dd = 2 a for a power-law contact (the Sneddon force's slope)
+    return Sweep(delta, p_star, zeros, zeros, load_slope=(2.0 / a_nom) * a.sum(1))
+
+
 def at_pressures(
     gamma: Tensor,
     h: Tensor,
@@ -353,37 +378,40 @@ def at_pressures(
     """The exact-law response of (B, N) designs where P*(Delta) equals p_star (B, M), and
     P*_max (B,) (detached); Delta = Delta_max where p_star >= P*_max.
 
-    Delta (B, M), found without gradients by Newton steps from the linear interpolation of
-    an ``n_delta``-sample sweep and kept inside the sweep's bracket of the root (P* grows
-    with Delta), is ``Sweep.delta``; P* and S* there carry gradients in gamma and h at
-    fixed Delta, alpha is alpha(p_star) with its gradient at fixed pressure. ``sweep_fn``
-    (default :func:`sweep`) must accept a (B, M) ``delta`` and give ``load_slope``.
+    Delta (B, M) is found without gradients: Newton steps from the linear interpolation of
+    an ``n_delta``-sample sweep, kept inside the sweep's bracket of the root (P* grows with
+    Delta). Then one sweep with gradients at that Delta (``Sweep.delta``): P* and S* there
+    carry gradients in gamma and h at fixed Delta, and alpha is alpha(p_star) with its
+    gradient at fixed pressure. ``sweep_fn`` (default :func:`sweep`) must accept a (B, M)
+    ``delta`` and give ``load_slope``; for the default, the Newton steps evaluate only P*
+    and its slope (:func:`_load_and_slope`).
     """
     fn = sweep_fn or sweep
+    newton_fn = _load_and_slope if fn is sweep else fn
     with torch.no_grad():
-        coarse = fn(gamma, h, settings, n_delta=n_delta)
-        knots = coarse.delta.expand_as(coarse.p_star)
+        grid = delta_grid(settings, n_delta, dtype=gamma.dtype).to(gamma.device)
+        coarse = newton_fn(gamma, h, settings, delta=grid.expand(gamma.shape[0], -1))
+        knots = coarse.delta
         p_max = coarse.p_star[:, -1]
         beyond = p_star >= p_max[:, None]
         delta = interp(p_star, coarse.p_star, knots)
         step = float(knots[0, 1] - knots[0, 0])
         lo, hi = (delta - step).clamp_min(0.0), (delta + step).clamp_max(settings.delta_max)
         tol = max(NEWTON_TOL, 64 * torch.finfo(p_star.dtype).eps) * p_star.abs()
-    # evaluated with gradients (cheap to keep): the last evaluation is the result
+        for _ in range(NEWTON_STEPS):
+            sw = newton_fn(gamma, h, settings, delta=delta)
+            if sw.load_slope is None:
+                raise ValueError("at_pressures needs a sweep_fn that gives load_slope")
+            resid = torch.where(beyond, 0.0, sw.p_star - p_star)
+            # converged points stay put: each point's Delta, and so a design's result, does
+            # not depend on the other rows of the batch
+            done = resid.abs() <= tol
+            if bool(done.all()):
+                break
+            slope = sw.load_slope
+            move = torch.where(~done & (slope > 0), resid / torch.where(slope > 0, slope, 1.0), 0.0)
+            delta = torch.minimum(torch.maximum(delta - move, lo), hi)
     sw = fn(gamma, h, settings, delta=delta)
-    if sw.load_slope is None:
-        raise ValueError("at_pressures needs a sweep_fn that gives load_slope")
-    for _ in range(NEWTON_STEPS):
-        resid = torch.where(beyond, 0.0, sw.p_star.detach() - p_star)
-        # converged points stay put: each point's Delta, and so a design's result, does
-        # not depend on the other rows of the batch
-        done = resid.abs() <= tol
-        if bool(done.all()):
-            break
-        slope = sw.load_slope
-        move = torch.where(~done & (slope > 0), resid / torch.where(slope > 0, slope, 1.0), 0.0)
-        delta = torch.minimum(torch.maximum(delta - move, lo), hi)
-        sw = fn(gamma, h, settings, delta=delta)
     # One Newton step in alpha at the converged, detached Delta: its value is alpha(p) to
     # second order in the residual, and its gradient is the implicit one, d alpha/d theta
     # at fixed p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
