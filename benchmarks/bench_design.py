@@ -4,7 +4,13 @@ Targets (issue 5): surrogate + refinement <= 0.3 s per target; 50-start multista
 target; 100 targets in one batched call <= 10 s; `metainterface design --target saturating`,
 process start included, <= 10 s. Quality: saturating and bilinear <= 1 % after refinement,
 surrogate + refinement at least as good as multistart, realisable targets within 2 %.
-Run: python benchmarks/bench_design.py [--skip-cli] [--batch 100]
+
+"At least as good" is judged over --seeds seeds (the hedge's and the multistart's random
+starts): the median error of the surrogate pipeline (CLI defaults) against that of the
+50-start multistart, equal within the design tolerance RefineSettings.tol_error (1e-5).
+One seed's errors below ~0.01 % rank nothing: the exact law's loss has kinks where
+asperities engage, and where a refinement stops among them moves with 1e-13 perturbations.
+Run: python benchmarks/bench_design.py [--skip-cli] [--batch 100] [--seeds 4]
 """
 
 import argparse
@@ -17,6 +23,7 @@ import numpy as np
 import torch
 
 from metainterface.design import builtin_target, design
+from metainterface.design.refine import RefineSettings
 from metainterface.design.targets import Target, design_targets
 from metainterface.physics import CellSettings
 
@@ -32,10 +39,31 @@ def realisable_targets(count: int, seed: int = 7) -> list[Target]:
     return design_targets([f"random{i}" for i in range(count)], g, h, s)
 
 
+def compare(targets: list[Target], seeds: int) -> None:
+    """Median errors over seeds: surrogate pipeline (CLI defaults) vs 50-start multistart."""
+    tol = RefineSettings().tol_error
+    runs = {"surrogate (CLI)": [], "multistart": []}
+    for seed in range(seeds):
+        runs["surrogate (CLI)"].append(
+            [r.error for r in design(targets, "surrogate", hedge=8, fallback=50, seed=seed)]
+        )
+        runs["multistart"].append([r.error for r in design(targets, "multistart", seed=seed)])
+    med = {k: np.median(np.array(v), axis=0) for k, v in runs.items()}
+    print(f"median refined error over seeds 0-{seeds - 1}:")
+    for i, t in enumerate(targets):
+        s, m = med["surrogate (CLI)"][i], med["multistart"][i]
+        verdict = "yes" if s <= m + tol else "NO"
+        print(
+            f"  {t.name:<12} surrogate (CLI) {100 * s:.4f} %, multistart {100 * m:.4f} %: "
+            f"at least as good (within {100 * tol:g} %): {verdict}"
+        )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--skip-cli", action="store_true")
     ap.add_argument("--batch", type=int, default=100)
+    ap.add_argument("--seeds", type=int, default=4, help="seeds of the quality comparison")
     args = ap.parse_args()
     targets = [builtin_target(n) for n in ("saturating", "bilinear", "linear")]
     design(targets[:1], "surrogate")  # warm-up (imports, model load)
@@ -53,6 +81,7 @@ def main() -> None:
                 f"{r.target.name:<12}{label:<20}{100 * r.initial_error:>9.2f}%"
                 f"{100 * r.error:>8.3f}%{wall:>10.2f}"
             )
+    compare(targets, args.seeds)
     batch = realisable_targets(args.batch)
     for label, hedge in (("paper's pipeline", 0), ("CLI defaults", 8)):
         t0 = time.perf_counter()
