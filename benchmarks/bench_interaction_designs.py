@@ -8,11 +8,9 @@ design: its target error as the design step reports it (the model's, on the targ
 grid), and the relative error ||alpha - alpha_target|| / ||alpha_target|| at the 8 loads
 of the design's own model and of the BEM.
 
-Target: designs made with --physics interacting keep their target error in BEM. The BEM at
-768 x 768 counts contact pixels, which on its own reads alpha high by ~0.5-2 % (the uniform
-cells of bench_interaction.py, refined to 1536 x 1536), so "keep" is read as: BEM error
-no more than the design's model error plus that resolution, and no worse than the design
-made with the paper's independent model.
+Target: designs made with --physics interacting keep their target error in BEM. The BEM's
+contact area has sub-pixel edges (``bem.contact_area``; the plain count of grid points in
+contact reads alpha 1-3 % high at 768 x 768, and its error is given too).
 
 BEM results are cached in benchmarks/results/interaction_designs_<M>.json with the designs,
 so a run that is interrupted resumes, and a rerun only re-prints.
@@ -41,6 +39,12 @@ PHYSICS = ("independent", "interacting")
 N_LOADS = 8
 
 
+def target_error_of(alpha: np.ndarray, p_star: np.ndarray, target) -> float:
+    """||alpha - alpha_target|| / ||alpha_target|| at loads p_star (all inside the target)."""
+    ref = np.interp(p_star, target.p_star, target.alpha)
+    return float(np.linalg.norm(alpha - ref) / np.linalg.norm(ref))
+
+
 def run_case(target_name: str, physics: str, grid: int, jobs: int) -> dict:
     """Design for one target with one model, then its BEM check; a JSON-ready record."""
     target = builtin_target(target_name)
@@ -57,6 +61,7 @@ def run_case(target_name: str, physics: str, grid: int, jobs: int) -> dict:
     t1 = time.perf_counter()
     result = plan.solve(jobs)
     bem_error, model_error = result.target_errors()
+    pixel_error = target_error_of(result.alpha_bem_pixels, result.p_star, target)
     return {
         "target": target_name,
         "physics": physics,
@@ -67,6 +72,8 @@ def run_case(target_name: str, physics: str, grid: int, jobs: int) -> dict:
         "p_star": result.p_star.tolist(),
         "alpha_bem": result.alpha_bem.tolist(),
         "alpha_model": result.alpha_model.tolist(),
+        "alpha_bem_pixels": result.alpha_bem_pixels.tolist(),
+        "bem_pixels_error_at_loads": pixel_error,
         "model_error_at_loads": model_error,
         "bem_error_at_loads": bem_error,
         "bem_vs_model_upper_half": result.max_rel_err_upper,
@@ -85,14 +92,14 @@ def main() -> None:
     cache = json.loads(cache_path.read_text()) if cache_path.exists() else {}
     lines = [
         "| target | designed with | design error | model error at the loads | "
-        "BEM error at the loads | BEM vs model (upper half) |",
-        "|---|---|---|---|---|---|",
+        "BEM error at the loads | BEM vs model (upper half) | BEM error, pixel count |",
+        "|---|---|---|---|---|---|---|",
     ]
     print(lines[0], flush=True)
     for name in TARGETS:
         for physics in PHYSICS:
             key = f"{name}|{physics}"
-            if key not in cache:
+            if "alpha_bem_pixels" not in cache.get(key, {}):  # older: the count only
                 cache[key] = run_case(name, physics, args.grid, args.jobs)
                 write_text(cache_path, json.dumps(cache, indent=1) + "\n")
             r = cache[key]
@@ -100,7 +107,8 @@ def main() -> None:
                 f"| {name} | {physics} | {100 * r['design_error']:.3f} % | "
                 f"{100 * r['model_error_at_loads']:.2f} % | "
                 f"{100 * r['bem_error_at_loads']:.2f} % | "
-                f"{100 * r['bem_vs_model_upper_half']:.2f} % |"
+                f"{100 * r['bem_vs_model_upper_half']:.2f} % | "
+                f"{100 * r['bem_pixels_error_at_loads']:.2f} % |"
             )
             print(lines[-1], flush=True)
     if args.out:
