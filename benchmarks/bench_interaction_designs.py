@@ -39,12 +39,6 @@ PHYSICS = ("independent", "interacting")
 N_LOADS = 8
 
 
-def target_error_of(alpha: np.ndarray, p_star: np.ndarray, target) -> float:
-    """||alpha - alpha_target|| / ||alpha_target|| at loads p_star (all inside the target)."""
-    ref = np.interp(p_star, target.p_star, target.alpha)
-    return float(np.linalg.norm(alpha - ref) / np.linalg.norm(ref))
-
-
 def run_case(target_name: str, physics: str, grid: int, jobs: int) -> dict:
     """Design for one target with one model, then its BEM check; a JSON-ready record."""
     target = builtin_target(target_name)
@@ -61,7 +55,7 @@ def run_case(target_name: str, physics: str, grid: int, jobs: int) -> dict:
     t1 = time.perf_counter()
     result = plan.solve(jobs)
     bem_error, model_error = result.target_errors()
-    pixel_error = target_error_of(result.alpha_bem_pixels, result.p_star, target)
+    pixel_error = result.target_error(result.alpha_bem_pixels)
     return {
         "target": target_name,
         "physics": physics,

@@ -128,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
         f"(P* >= {result.p_star[result.upper_half][0]:.4g}): "
         f"{100 * result.max_rel_err_upper:.2f} % "
         f"(counting grid points in contact: "
-        f"{100 * result.summary()['max_rel_err_upper_half_pixels']:.2f} %)"
+        f"{100 * result.max_rel_err_upper_pixels:.2f} %)"
     )
     upper = result.upper_half
     print(

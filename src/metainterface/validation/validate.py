@@ -100,13 +100,18 @@ class ValidationResult:
         """Largest |rel_err| over all loads."""
         return float(np.abs(self.rel_err).max())
 
-    def target_errors(self) -> tuple[float, float] | None:
-        """Relative curve errors of BEM and model against the design's target, or None.
+    @property
+    def max_rel_err_upper_pixels(self) -> float:
+        """``max_rel_err_upper`` with the BEM's plain count of grid points in contact."""
+        return float(np.abs(self.alpha_bem_pixels / self.alpha_model - 1.0)[self.upper_half].max())
+
+    def target_error(self, alpha: np.ndarray) -> float | None:
+        """Relative curve error of alpha (K,), at this result's loads, against the design's
+        target, or None.
 
         ||alpha - alpha_target||_2 / ||alpha_target||_2 over the loads within the target's
-        pressure range (the target interpolated there): (BEM, model). The BEM figure is what
-        the manufactured surface would show; the model one is the design's own claim, at the
-        same loads. None without a target or with no load inside its range.
+        pressure range (the target interpolated there). None without a target or with no
+        load inside its range.
         """
         target = design_target(self.design)
         if target is None:
@@ -119,10 +124,18 @@ class ValidationResult:
         norm = float(np.linalg.norm(ref))
         if norm == 0.0:
             return None
-        return tuple(  # type: ignore[return-value]
-            float(np.linalg.norm(a[inside] - ref)) / norm
-            for a in (self.alpha_bem, self.alpha_model)
-        )
+        return float(np.linalg.norm(alpha[inside] - ref)) / norm
+
+    def target_errors(self) -> tuple[float, float] | None:
+        """``target_error`` of BEM and model: (BEM, model), or None.
+
+        The BEM figure is what the manufactured surface would show; the model one is the
+        design's own claim, at the same loads.
+        """
+        bem = self.target_error(self.alpha_bem)
+        if bem is None:
+            return None
+        return bem, self.target_error(self.alpha_model)  # type: ignore[return-value]
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (with the target errors if the design carries a target)."""
@@ -140,9 +153,7 @@ class ValidationResult:
             "p_star_max": float(self.p_star[-1]),
             "max_rel_err_upper_half": self.max_rel_err_upper,
             "max_rel_err": self.max_rel_err,
-            "max_rel_err_upper_half_pixels": float(
-                np.abs(self.alpha_bem_pixels / self.alpha_model - 1.0)[self.upper_half].max()
-            ),
+            "max_rel_err_upper_half_pixels": self.max_rel_err_upper_pixels,
             "max_local_pressure": float(self.p_max.max()),
             "max_residual": float(self.residual.max()),
             "bem_seconds": float(self.seconds.sum()),
