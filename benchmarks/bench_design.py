@@ -48,13 +48,16 @@ def compare(targets: list[Target], seeds: int) -> None:
             [r.error for r in design(targets, "surrogate", hedge=8, fallback=50, seed=seed)]
         )
         runs["multistart"].append([r.error for r in design(targets, "multistart", seed=seed)])
-    med = {k: np.median(np.array(v), axis=0) for k, v in runs.items()}
-    print(f"median refined error over seeds 0-{seeds - 1}:")
+    err = {k: 100 * np.array(v) for k, v in runs.items()}  # (seeds, targets) [%]
+    med = {k: np.median(v, axis=0) for k, v in err.items()}
+    print(f"median refined error over seeds 0-{seeds - 1} [seed range]:")
     for i, t in enumerate(targets):
         s, m = med["surrogate (CLI)"][i], med["multistart"][i]
-        verdict = "yes" if s <= m + tol else "NO"
+        verdict = "yes" if s <= m + 100 * tol else "NO"
+        ranges = {k: f"[{v[:, i].min():.4f}-{v[:, i].max():.4f}]" for k, v in err.items()}
         print(
-            f"  {t.name:<12} surrogate (CLI) {100 * s:.4f} %, multistart {100 * m:.4f} %: "
+            f"  {t.name:<12} surrogate (CLI) {s:.4f} % {ranges['surrogate (CLI)']}, "
+            f"multistart {m:.4f} % {ranges['multistart']}: "
             f"at least as good (within {100 * tol:g} %): {verdict}"
         )
 

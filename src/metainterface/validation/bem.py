@@ -110,8 +110,9 @@ def contact_area(
     averaged with the same along the columns. Against Sneddon's closed forms for single
     power-law asperities (gamma 1.8-4) at 256^2 the count reads +1.0 to +3.5 % for contact
     radii of 10-30 steps, this +0.1 to +2.5 %, and within 0.7 % from 18 steps on
-    (tests/validation/test_bem.py). It still reads small contacts high: on grid lines that
-    graze an edge, p^2 is not linear over a step.
+    (benchmarks/bench_contact_area.py; bounds in tests/validation/test_bem.py). It still
+    reads small contacts high: on grid lines that graze an edge, p^2 is not linear over a
+    step.
     """
     p = np.asarray(pressure, dtype=np.float64)
     owner = np.asarray(owner).ravel()
