@@ -8,6 +8,7 @@ alpha = A_tot / A_nom, S* = dP*/dalpha.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -189,6 +190,7 @@ class _SweepFunction(torch.autograd.Function):
                 gamma, log_a, a2, da, u, a2r, e, r, stiffness, safe_darea, in_contact
             )
         ctx.smooth, ctx.radius, ctx.a_nom = smooth, radius, a_nom
+        ctx.set_materialize_grads(False)  # an unused output's gradient arrives as None
         load_slope = dforce / a_nom
         ctx.mark_non_differentiable(load_slope)
         return force / a_nom, (math.pi / a_nom) * a2.sum(1), stiffness, load_slope
@@ -197,47 +199,45 @@ class _SweepFunction(torch.autograd.Function):
     def backward(ctx, g_p, g_alpha, g_s, _g_slope):
         (gamma, log_a, a2, da, u, a2r, e, r, stiffness, safe_darea, in_contact) = ctx.saved_tensors
         smooth, a_nom = ctx.smooth, ctx.a_nom
-        zeros = torch.zeros_like(stiffness)
-        g_p = zeros if g_p is None else g_p
-        g_alpha = zeros if g_alpha is None else g_alpha
-        g_s = zeros if g_s is None else g_s * in_contact / safe_darea
-        # upstream weights per (b, k) of F, A2, DF and DA
-        c_f = (g_p / a_nom)[:, None, :]
-        c_a = (g_alpha * (2.0 * math.pi / a_nom))[:, None, :]  # d alpha = (pi / A) 2 a da
-        c_df = (2.0 * g_s)[:, None, :]
-        c_da = (-2.0 * math.pi * g_s * stiffness)[:, None, :]
 
         def dot(x: Tensor, c: Tensor) -> Tensor:
             return (x * c).sum(-1)  # (B, N)
 
         p = 1.0 / gamma
         f_coef = 2.0 * gamma / (gamma + 1.0)
-        df_coef = 2.0 / (gamma + 1.0) ** 2
         t = log_a + dlog_kc(gamma, ctx.radius)[:, :, None]  # T; always times a: no mask needed
-        a2r_dot_da = dot(a2r, c_da)
+        # Terms of outputs without an upstream gradient are skipped, not multiplied by zero:
+        # the refinement differentiates alpha and P* only, and S* takes ~half the work.
         # d/dx (the gradient of h is minus its sum over K):
         #   F: f_coef a e (1 + p);  A2: 2 a da/dx = 2 p a^2 r;  DF: 2 e da/dx = 2 p u r;
         #   DA: 2 pi p a^2 r (2 p - 1) r;  softplus: DF += 2 a de/dx, DA += 2 pi p a^2 de/dx
-        g_x = (
-            f_coef * (1.0 + p) * dot(u, c_f)
-            + p * dot(a2r, c_a)
-            + p * dot(u * r, c_df)
-            + p * (2.0 * p - 1.0) * dot(a2r * r, c_da)
-        )
-        if smooth is not None:  # de/dx = kappa_s e (1 - e)
-            g_x = g_x + smooth * (
-                dot(u, c_df) - dot(u * e, c_df) + p * (a2r_dot_da - dot(a2r * e, c_da))
-            )
         # d/dgamma: F: d a df_coef + f_coef d da/dg;  A2: 2 a da/dg;  DF: 2 e da/dg;
         # DA: -2 pi p^2 a^2 r (1 + 2 T), with da/dg = -p a T
-        g_g = (
-            df_coef * dot(da, c_f)
-            - f_coef * p * dot(da * t, c_f)
-            - p * dot(a2 * t, c_a)
-            - p * dot(u * t, c_df)
-            - p * p * (a2r_dot_da + 2.0 * dot(a2r * t, c_da))
-        )
-        return g_g, -g_x, None, None, None, None
+        g_x: list[Tensor] = []
+        g_g: list[Tensor] = []
+        if g_p is not None:  # upstream weights per (b, k) of F
+            c_f = (g_p / a_nom)[:, None, :]
+            g_x.append(f_coef * (1.0 + p) * dot(u, c_f))
+            g_g += [2.0 / (gamma + 1.0) ** 2 * dot(da, c_f), -f_coef * p * dot(da * t, c_f)]
+        if g_alpha is not None:  # of A2: d alpha = (pi / A) 2 a da
+            c_a = (g_alpha * (2.0 * math.pi / a_nom))[:, None, :]
+            g_x.append(p * dot(a2r, c_a))
+            g_g.append(-p * dot(a2 * t, c_a))
+        if g_s is not None:  # of DF and DA
+            g_s = g_s * in_contact / safe_darea
+            c_df = (2.0 * g_s)[:, None, :]
+            c_da = (-2.0 * math.pi * g_s * stiffness)[:, None, :]
+            a2r_dot_da = dot(a2r, c_da)
+            g_x += [p * dot(u * r, c_df), p * (2.0 * p - 1.0) * dot(a2r * r, c_da)]
+            if smooth is not None:  # de/dx = kappa_s e (1 - e)
+                g_x.append(
+                    smooth
+                    * (dot(u, c_df) - dot(u * e, c_df) + p * (a2r_dot_da - dot(a2r * e, c_da)))
+                )
+            g_g += [-p * dot(u * t, c_df), -p * p * (a2r_dot_da + 2.0 * dot(a2r * t, c_da))]
+        if not g_x:  # only dP*/dDelta, which is not differentiable, had one
+            return torch.zeros_like(gamma), torch.zeros_like(gamma), None, None, None, None
+        return sum(g_g[1:], g_g[0]), -sum(g_x[1:], g_x[0]), None, None, None, None
 
 
 def interp(xq: Tensor, xp: Tensor, *fps: Tensor) -> Tensor | tuple[Tensor, ...]:
@@ -341,29 +341,32 @@ def alpha_at(
 NEWTON_STEPS, NEWTON_TOL = 8, 1e-10
 
 
-def _load_and_slope(
-    gamma: Tensor, h: Tensor, settings: CellSettings, *, delta: Tensor, **_: object
-) -> Sweep:
-    """P* and dP*/dDelta of the independent model at per-design Deltas (B, M), nothing else.
+def _independent_load(gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
+    """``load(delta=...)``: P* and dP*/dDelta of the independent model of (B, N) designs at
+    per-design Deltas (B, M), nothing else.
 
-    The Newton steps of :func:`at_pressures` need only these: ~15 tensor operations without
-    a graph, where :func:`sweep` takes ~35 and keeps its products for a backward. alpha and
-    S* are left None-like (zeros) and are not to be used.
+    The Newton steps of :func:`at_pressures` need only these: ~12 tensor operations a call
+    without a graph (the per-asperity constants are computed once, here), where
+    :func:`sweep` takes ~35 and keeps its products for a backward. alpha and S* are left
+    zeros and are not to be used.
     """
-    x = delta[:, None, :] - anchor(h)[:, :, None]  # (B, N, M)
-    d = torch.relu(x)
+    h = anchor(h)[:, :, None]
     floor = _contact_floor(gamma.dtype)
     inv_g = (1.0 / gamma)[:, :, None]
-    a = torch.exp(
-        inv_g * (torch.log(d.clamp_min(floor)) - log_kc(gamma, settings.radius)[:, :, None])
-    )
-    a = a * (d > floor)
+    lkc = log_kc(gamma, settings.radius)[:, :, None]
     f_coef = (2.0 * gamma / (gamma + 1.0))[:, :, None]
     a_nom = settings.nominal_area
-    p_star = (f_coef * d * a).sum(1) / a_nom
-    zeros = torch.zeros_like(p_star)
-    # dF/dd = 2 a for a power-law contact (the Sneddon force's slope)
-    return Sweep(delta, p_star, zeros, zeros, load_slope=(2.0 / a_nom) * a.sum(1))
+
+    def load(*, delta: Tensor, **_: object) -> Sweep:
+        d = torch.relu(delta[:, None, :] - h)  # (B, N, M)
+        a = torch.exp(inv_g * (torch.log(d.clamp_min(floor)) - lkc))
+        a = a * (d > floor)
+        p_star = (f_coef * d * a).sum(1) / a_nom
+        zeros = torch.zeros_like(p_star)
+        # dF/dd = 2 a for a power-law contact (the Sneddon force's slope)
+        return Sweep(delta, p_star, zeros, zeros, load_slope=(2.0 / a_nom) * a.sum(1))
+
+    return load
 
 
 def at_pressures(
@@ -384,13 +387,16 @@ def at_pressures(
     carry gradients in gamma and h at fixed Delta, and alpha is alpha(p_star) with its
     gradient at fixed pressure. ``sweep_fn`` (default :func:`sweep`) must accept a (B, M)
     ``delta`` and give ``load_slope``; for the default, the Newton steps evaluate only P*
-    and its slope (:func:`_load_and_slope`).
+    and its slope (:func:`_independent_load`).
     """
     fn = sweep_fn or sweep
-    newton_fn = _load_and_slope if fn is sweep else fn
     with torch.no_grad():
+        if fn is sweep:
+            newton_fn = _independent_load(gamma, h, settings)
+        else:
+            newton_fn = functools.partial(fn, gamma, h, settings)
         grid = delta_grid(settings, n_delta, dtype=gamma.dtype).to(gamma.device)
-        coarse = newton_fn(gamma, h, settings, delta=grid.expand(gamma.shape[0], -1))
+        coarse = newton_fn(delta=grid.expand(gamma.shape[0], -1))
         knots = coarse.delta
         p_max = coarse.p_star[:, -1]
         beyond = p_star >= p_max[:, None]
@@ -399,7 +405,7 @@ def at_pressures(
         lo, hi = (delta - step).clamp_min(0.0), (delta + step).clamp_max(settings.delta_max)
         tol = max(NEWTON_TOL, 64 * torch.finfo(p_star.dtype).eps) * p_star.abs()
         for _ in range(NEWTON_STEPS):
-            sw = newton_fn(gamma, h, settings, delta=delta)
+            sw = newton_fn(delta=delta)
             if sw.load_slope is None:
                 raise ValueError("at_pressures needs a sweep_fn that gives load_slope")
             resid = torch.where(beyond, 0.0, sw.p_star - p_star)
