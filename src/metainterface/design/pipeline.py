@@ -24,6 +24,7 @@ from metainterface.design.refine import (
     RefineSettings,
     TargetGrid,
     from_design,
+    polish,
     refine,
     relative_error,
     to_design,
@@ -252,9 +253,7 @@ def _design(
         kept_rows = err.view(len(targets), per_target).topk(top, largest=False).indices + offset
         kept_rows = kept_rows.reshape(-1)
         kept = rows.rows(kept_rows)
-        raw_w = refine(
-            raw[kept_rows], settings, kept, refine_settings.polishing(), hertz, extra_loss, physics
-        )
+        raw_w = polish(raw[kept_rows], settings, kept, refine_settings, hertz, extra_loss, physics)
         g_w, h_w = to_design(raw_w, settings, hertz)
         err_w = relative_error(g_w, h_w, settings, kept, physics)
         better = err_w < err[kept_rows]

@@ -23,10 +23,10 @@ import torch
 from torch import Tensor
 from torch.nn import functional as nnf
 
-from metainterface.design import lbfgs
+from metainterface.design import lbfgs, levmar
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import relative_l2
-from metainterface.physics.forward import DEFAULT_PHYSICS, alpha_at
+from metainterface.physics.curves import at_delta, relative_l2, solve_delta
+from metainterface.physics.forward import DEFAULT_PHYSICS, alpha_at, sweep_for
 
 DTYPE = torch.float64
 
@@ -52,6 +52,14 @@ class RefineSettings:
     polish_iterations: int = 100
     polish_tol_stall: float = 1e-4
     polish_exact: bool = True
+    # The polish's method on the exact law: "levmar", Levenberg-Marquardt on the loss's
+    # residuals (:func:`residuals`; their Jacobian costs one gradient), steps cut to
+    # ``polish_max_step`` in the unbounded parameters; or "lbfgs", more iterations of the
+    # stages' method. On the built-in targets Levenberg-Marquardt reaches in ~40 evaluations
+    # what L-BFGS does not in 130 (bilinear 0.028 % -> ~0 %): the exact law's loss has kinks
+    # and curved valleys that Gauss-Newton steps follow and quasi-Newton pairs do not.
+    polish_method: str = "levmar"
+    polish_max_step: float = 0.3
     # the stages use the exact contact law instead of the softplus (set by ``polishing``)
     exact: bool = False
     # L-BFGS stops a row whose gradient (max abs) or loss change falls below these; the
@@ -177,6 +185,46 @@ def masked_loss(
     return err / (target.alpha**2).mean(-1)
 
 
+def residuals(
+    raw: Tensor,
+    settings: CellSettings,
+    target: TargetGrid,
+    undershoot: float = 0.1,
+    physics: str = DEFAULT_PHYSICS,
+    hertz: bool = False,
+) -> tuple[Tensor, Tensor]:
+    """The exact-law loss as residuals r (B, M), ||r||^2 = :func:`masked_loss`, and their
+    Jacobian in the unbounded parameters, dr/draw (B, M, D).
+
+    Each point's alpha depends on the parameters only through the design at its own Delta
+    (solved once, without gradients), so the batch is replicated once per point, (B M) rows
+    at one Delta each, and one backward pass of the summed alphas gives every row of J: the
+    cost of one gradient evaluation, not M.
+    """
+    b, m = target.p.shape
+    fn = sweep_for(physics)
+    with torch.no_grad():
+        gamma, h = to_design(raw, settings, hertz)
+        delta, p_max = solve_delta(gamma, h, settings, target.p, sweep_fn=fn)
+        w = torch.where(target.p <= p_max[:, None], 1.0, undershoot)
+        norm = w.sum(-1, keepdim=True) * (target.alpha**2).mean(-1, keepdim=True)
+        weight = (w / norm).sqrt()  # (B, M)
+    rep = raw.detach().repeat_interleave(m, 0).requires_grad_(True)
+    g_rep, h_rep = to_design(rep, settings, hertz)
+    alpha = at_delta(
+        g_rep,
+        h_rep,
+        settings,
+        target.p.reshape(-1, 1),
+        delta.reshape(-1, 1),
+        p_max.repeat_interleave(m),
+        sweep_fn=fn,
+    ).alpha
+    (jac,) = torch.autograd.grad(alpha.sum(), rep)
+    r = weight * (alpha.detach().view(b, m) - target.alpha)
+    return r, weight[..., None] * jac.view(b, m, -1)
+
+
 def relative_error(
     gamma: Tensor,
     h: Tensor,
@@ -190,6 +238,37 @@ def relative_error(
     with torch.no_grad():
         alpha, _ = alpha_at(gamma, h, settings, target.p, physics=physics, exact=True)
         return relative_l2(alpha, target.alpha)
+
+
+def polish(
+    raw: Tensor,
+    settings: CellSettings,
+    target: TargetGrid,
+    rs: RefineSettings | None = None,
+    hertz: bool = False,
+    extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
+    physics: str = DEFAULT_PHYSICS,
+) -> Tensor:
+    """The polish after the stages (``RefineSettings.polishing``): Levenberg-Marquardt on
+    the exact law if ``rs.polish_method`` says so and the loss is a sum of squares (no
+    ``extra_loss``), else L-BFGS. Returns the polished raw parameters (B, D)."""
+    rs = rs or RefineSettings()
+    if rs.polish_method not in ("levmar", "lbfgs"):
+        raise ValueError(f"polish_method must be 'levmar' or 'lbfgs', got {rs.polish_method!r}")
+    if rs.polish_method == "lbfgs" or extra_loss is not None or not rs.polish_exact:
+        return refine(raw, settings, target, rs.polishing(), hertz, extra_loss, physics)
+
+    def fun(z: Tensor, idx: Tensor) -> tuple[Tensor, Tensor]:
+        return residuals(z, settings, target.rows(idx), rs.undershoot_weight, physics, hertz)
+
+    return levmar.least_squares(
+        fun,
+        raw.detach().to(DTYPE),
+        max_iter=rs.polish_iterations,
+        tol_loss=rs.tol_error**2,
+        tol_stall=rs.polish_tol_stall,
+        max_step=rs.polish_max_step,
+    ).x
 
 
 def refine(

@@ -381,13 +381,31 @@ def at_pressures(
     """The exact-law response of (B, N) designs where P*(Delta) equals p_star (B, M), and
     P*_max (B,) (detached); Delta = Delta_max where p_star >= P*_max.
 
-    Delta (B, M) is found without gradients: Newton steps from the linear interpolation of
-    an ``n_delta``-sample sweep, kept inside the sweep's bracket of the root (P* grows with
-    Delta). Then one sweep with gradients at that Delta (``Sweep.delta``): P* and S* there
-    carry gradients in gamma and h at fixed Delta, and alpha is alpha(p_star) with its
-    gradient at fixed pressure. ``sweep_fn`` (default :func:`sweep`) must accept a (B, M)
-    ``delta`` and give ``load_slope``; for the default, the Newton steps evaluate only P*
-    and its slope (:func:`_independent_load`).
+    Delta is solved for without gradients (:func:`solve_delta`), then one sweep with
+    gradients at that Delta (:func:`at_delta`): P* and S* there carry gradients in gamma and
+    h at fixed Delta, and alpha is alpha(p_star) with its gradient at fixed pressure.
+    ``sweep_fn`` (default :func:`sweep`) must accept a (B, M) ``delta`` and give
+    ``load_slope``.
+    """
+    delta, p_max = solve_delta(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
+    return at_delta(gamma, h, settings, p_star, delta, p_max, sweep_fn=sweep_fn), p_max
+
+
+def solve_delta(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_star: Tensor,
+    *,
+    n_delta: int | None = None,
+    sweep_fn: Callable[..., Sweep] | None = None,
+) -> tuple[Tensor, Tensor]:
+    """Delta (B, M) where P*(Delta) = p_star (B, M) for (B, N) designs, Delta_max where
+    p_star >= P*_max; and P*_max (B,). No gradients.
+
+    Newton steps from the linear interpolation of an ``n_delta``-sample sweep, kept inside
+    the sweep's bracket of the root (P* grows with Delta). For the default ``sweep_fn``
+    the steps evaluate only P* and its slope (:func:`_independent_load`).
     """
     fn = sweep_fn or sweep
     with torch.no_grad():
@@ -417,13 +435,30 @@ def at_pressures(
             slope = sw.load_slope
             move = torch.where(~done & (slope > 0), resid / torch.where(slope > 0, slope, 1.0), 0.0)
             delta = torch.minimum(torch.maximum(delta - move, lo), hi)
-    sw = fn(gamma, h, settings, delta=delta)
-    # One Newton step in alpha at the converged, detached Delta: its value is alpha(p) to
-    # second order in the residual, and its gradient is the implicit one, d alpha/d theta
-    # at fixed p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
-    ok = (sw.stiffness > 0) & ~beyond
+    return delta, p_max
+
+
+def at_delta(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_star: Tensor,
+    delta: Tensor,
+    p_max: Tensor,
+    *,
+    sweep_fn: Callable[..., Sweep] | None = None,
+) -> Sweep:
+    """The response of (B, N) designs at the Deltas (B, M) that :func:`solve_delta` found
+    for p_star (B, M), with alpha moved to p_star; P*_max (B,) as it gave.
+
+    One Newton step in alpha at the converged, detached Delta: its value is alpha(p) to
+    second order in the residual, and its gradient is the implicit one, d alpha/d theta at
+    fixed p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
+    """
+    sw = (sweep_fn or sweep)(gamma, h, settings, delta=delta)
+    ok = (sw.stiffness > 0) & (p_star < p_max[:, None])
     inv_s = torch.where(ok, 1.0 / torch.where(ok, sw.stiffness, 1.0), 0.0).detach()
-    return replace(sw, alpha=sw.alpha + (p_star - sw.p_star) * inv_s), p_max
+    return replace(sw, alpha=sw.alpha + (p_star - sw.p_star) * inv_s)
 
 
 def curves_numpy(
