@@ -10,7 +10,7 @@ starts): the median error of the surrogate pipeline (CLI defaults) against that 
 50-start multistart, equal within the design tolerance RefineSettings.tol_error (1e-5).
 One seed's errors below ~0.01 % rank nothing: the exact law's loss has kinks where
 asperities engage, and where a refinement stops among them moves with 1e-13 perturbations.
-Run: python benchmarks/bench_design.py [--skip-cli] [--batch 100] [--seeds 4]
+Run: python benchmarks/bench_design.py [--skip-cli] [--batch 100] [--seeds 4] [--polish lbfgs]
 """
 
 import argparse
@@ -39,15 +39,22 @@ def realisable_targets(count: int, seed: int = 7) -> list[Target]:
     return design_targets([f"random{i}" for i in range(count)], g, h, s)
 
 
-def compare(targets: list[Target], seeds: int) -> None:
+def compare(targets: list[Target], seeds: int, rs: RefineSettings) -> None:
     """Median errors over seeds: surrogate pipeline (CLI defaults) vs 50-start multistart."""
-    tol = RefineSettings().tol_error
+    tol = rs.tol_error
     runs = {"surrogate (CLI)": [], "multistart": []}
     for seed in range(seeds):
         runs["surrogate (CLI)"].append(
-            [r.error for r in design(targets, "surrogate", hedge=8, fallback=50, seed=seed)]
+            [
+                r.error
+                for r in design(
+                    targets, "surrogate", hedge=8, fallback=50, seed=seed, refine_settings=rs
+                )
+            ]
         )
-        runs["multistart"].append([r.error for r in design(targets, "multistart", seed=seed)])
+        runs["multistart"].append(
+            [r.error for r in design(targets, "multistart", seed=seed, refine_settings=rs)]
+        )
     err = {k: 100 * np.array(v) for k, v in runs.items()}  # (seeds, targets) [%]
     med = {k: np.median(v, axis=0) for k, v in err.items()}
     print(f"median refined error over seeds 0-{seeds - 1} [seed range]:")
@@ -67,16 +74,25 @@ def main() -> None:
     ap.add_argument("--skip-cli", action="store_true")
     ap.add_argument("--batch", type=int, default=100)
     ap.add_argument("--seeds", type=int, default=4, help="seeds of the quality comparison")
+    ap.add_argument(
+        "--polish",
+        choices=["levmar", "lbfgs"],
+        default=RefineSettings().polish_method,
+        help="the polish's method (RefineSettings.polish_method), to compare them",
+    )
     args = ap.parse_args()
+    rs = RefineSettings(polish_method=args.polish)
     targets = [builtin_target(n) for n in ("saturating", "bilinear", "linear")]
     design(targets[:1], "surrogate")  # warm-up (imports, model load)
-    print(f"torch {torch.__version__}, {torch.get_num_threads()} threads")
+    print(f"torch {torch.__version__}, {torch.get_num_threads()} threads, polish {args.polish}")
     print(f"{'target':<12}{'method':<20}{'zero-shot':>10}{'refined':>9}{'s/target':>10}")
     # the paper's pipeline (hedge 0), the CLI's default (8 random starts beside the zero-shot
     # one, and a 50-start fallback for targets still missed by > 2 %), and the two baselines
     for method, hedge in (("surrogate", 0), ("surrogate", 8), ("multistart", 0), ("hertz", 0)):
         t0 = time.perf_counter()
-        results = design(targets, method, starts=50, hedge=hedge, fallback=50 if hedge else 0)
+        results = design(
+            targets, method, starts=50, hedge=hedge, fallback=50 if hedge else 0, refine_settings=rs
+        )
         wall = (time.perf_counter() - t0) / len(targets)
         label = "surrogate (CLI)" if hedge else method
         for r in results:
@@ -84,11 +100,13 @@ def main() -> None:
                 f"{r.target.name:<12}{label:<20}{100 * r.initial_error:>9.2f}%"
                 f"{100 * r.error:>8.3f}%{wall:>10.2f}"
             )
-    compare(targets, args.seeds)
+    compare(targets, args.seeds, rs)
     batch = realisable_targets(args.batch)
     for label, hedge in (("paper's pipeline", 0), ("CLI defaults", 8)):
         t0 = time.perf_counter()
-        res = design(batch, "surrogate", hedge=hedge, fallback=50 if hedge else 0)
+        res = design(
+            batch, "surrogate", hedge=hedge, fallback=50 if hedge else 0, refine_settings=rs
+        )
         wall = time.perf_counter() - t0
         errs = np.array([r.error for r in res])
         print(

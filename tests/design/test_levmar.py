@@ -97,3 +97,24 @@ def test_residuals_are_the_exact_loss_and_their_jacobian_its_gradient(hertz):
             - residuals(raw - step, s, grid, 0.1, hertz=hertz)[0]
         ) / (2 * eps)
         torch.testing.assert_close(jac[:, :, k], diff, rtol=1e-4, atol=1e-7)
+
+
+def test_the_polish_is_never_worse_than_the_lbfgs_polish():
+    # The linear law is not realisable: Levenberg-Marquardt stops above the design tolerance
+    # and the L-BFGS polish runs from the same start; the better of the two is kept.
+    from metainterface.design.refine import RefineSettings, polish, refine
+
+    s = CellSettings()
+    target = builtin_target("linear")
+    grid = TargetGrid.from_curves([(target.p_star, target.alpha)] * 2, 64)
+    gen = torch.Generator().manual_seed(3)
+    raw = torch.randn(2, 17, generator=gen, dtype=F64) - 1.0
+    rs = RefineSettings(polish_iterations=20)
+
+    def loss(x):
+        return masked_loss(*to_design(x, s), s, grid, None, rs.undershoot_weight)
+
+    both = loss(polish(raw, s, grid, rs))
+    lbfgs_only = loss(refine(raw, s, grid, rs.polishing()))
+    assert (both <= lbfgs_only).all()
+    assert (both < loss(raw)).all()

@@ -249,9 +249,10 @@ def polish(
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
     physics: str = DEFAULT_PHYSICS,
 ) -> Tensor:
-    """The polish after the stages (``RefineSettings.polishing``): Levenberg-Marquardt on
-    the exact law if ``rs.polish_method`` says so and the loss is a sum of squares (no
-    ``extra_loss``), else L-BFGS. Returns the polished raw parameters (B, D)."""
+    """The polish after the stages: Levenberg-Marquardt on the exact law if
+    ``rs.polish_method`` says so and the loss is a sum of squares (no ``extra_loss``), then
+    L-BFGS (``RefineSettings.polishing``) on the rows it left above the design tolerance;
+    else L-BFGS alone. Returns the polished raw parameters (B, D)."""
     rs = rs or RefineSettings()
     if rs.polish_method not in ("levmar", "lbfgs"):
         raise ValueError(f"polish_method must be 'levmar' or 'lbfgs', got {rs.polish_method!r}")
@@ -261,14 +262,31 @@ def polish(
     def fun(z: Tensor, idx: Tensor) -> tuple[Tensor, Tensor]:
         return residuals(z, settings, target.rows(idx), rs.undershoot_weight, physics, hertz)
 
-    return levmar.least_squares(
+    res = levmar.least_squares(
         fun,
         raw.detach().to(DTYPE),
         max_iter=rs.polish_iterations,
         tol_loss=rs.tol_error**2,
         tol_stall=rs.polish_tol_stall,
         max_step=rs.polish_max_step,
-    ).x
+    )
+    # A target point just past an asperity's engagement (alpha ~ (Delta - h)^(2/gamma), an
+    # infinite slope) makes the linear model wrong at any step size, and Levenberg-Marquardt
+    # can stall there, where L-BFGS's line search steps over the kink. The rows it left above
+    # the design tolerance also get the L-BFGS polish from the same start, and keep the
+    # better of the two (a row in a local minimum, the linear law's, stops both at once).
+    x = res.x
+    left = (res.loss > rs.tol_error**2).nonzero(as_tuple=True)[0]
+    if left.shape[0]:
+        rows = target.rows(left)
+        y = refine(raw[left], settings, rows, rs.polishing(), hertz, None, physics)
+        with torch.no_grad():
+            loss = masked_loss(
+                *to_design(y, settings, hertz), settings, rows, None, rs.undershoot_weight, physics
+            )
+        better = loss < res.loss[left]
+        x[left] = torch.where(better[:, None], y, x[left])
+    return x
 
 
 def refine(
