@@ -25,8 +25,8 @@ from torch.nn import functional as nnf
 
 from metainterface.design import lbfgs, levmar
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import at_delta, relative_l2, solve_delta
-from metainterface.physics.forward import DEFAULT_PHYSICS, alpha_at, sweep_for
+from metainterface.physics.curves import at_delta, interp_weights, relative_l2, solve_delta
+from metainterface.physics.forward import DEFAULT_PHYSICS, alpha_at, alpha_sweep_for, sweep_for
 
 DTYPE = torch.float64
 
@@ -177,12 +177,57 @@ def masked_loss(
     With the softplus (the stages) alpha is interpolated in the paper's 128-sample sweep;
     on the exact law (the polish) it is exact at the target's pressures, as in
     :func:`relative_error`."""
-    alpha, p_max = alpha_at(
-        gamma, h, settings, target.p, physics=physics, smooth=smooth, exact=smooth is None
-    )
+    if smooth is not None:
+        sw = alpha_sweep_for(physics)(gamma, h, settings, smooth=smooth)
+        return _InterpolatedLoss.apply(sw.p_star, sw.alpha, target.p, target.alpha, undershoot)
+    alpha, p_max = alpha_at(gamma, h, settings, target.p, physics=physics, exact=True)
+    return (point_weights(p_max, target, undershoot) * (alpha - target.alpha) ** 2).sum(-1)
+
+
+def point_weights(p_max: Tensor, target: TargetGrid, undershoot: float = 0.1) -> Tensor:
+    """Each target point's weight in :func:`masked_loss` (B, M): 1 where the design's curve
+    reaches it (p <= P*_max (B,)), ``undershoot`` beyond, over sum(weights) mean(alpha_t^2)."""
     w = torch.where(target.p <= p_max[:, None], 1.0, undershoot)
-    err = (w * (alpha - target.alpha) ** 2).sum(-1) / w.sum(-1)
-    return err / (target.alpha**2).mean(-1)
+    return w / (w.sum(-1, keepdim=True) * (target.alpha**2).mean(-1, keepdim=True))
+
+
+class _InterpolatedLoss(torch.autograd.Function):
+    """(P*, alpha) of a sweep (B, K) -> :func:`masked_loss` (B,), alpha interpolated at the
+    target's pressures in the sweep with a (0, 0) knot first, held beyond its end.
+
+    The stages evaluate this ~300 times per design; autograd through the interpolation and
+    the weighted MSE took ~45 operations for the backward, the closed form below ~12:
+    with dL/dalpha_q = 2 weight (alpha_q - alpha_t), alpha_q = (1 - w) f0 + w f1 and
+    w = (p - x0) / (x1 - x0), dalpha_q/dx0 = (w - 1) s and dalpha_q/dx1 = -w s, s the
+    interval's slope (only where w is not clamped); the weights' step at P*_max has no
+    gradient.
+    """
+
+    @staticmethod
+    def forward(ctx, p_sweep, alpha_sweep, p, alpha_t, undershoot):
+        zero = torch.zeros_like(p_sweep[:, :1])
+        xp, fp = torch.cat([zero, p_sweep], -1), torch.cat([zero, alpha_sweep], -1)
+        idx, w, inside, width = interp_weights(p, xp)
+        f0 = fp.gather(-1, idx - 1)
+        rise = fp.gather(-1, idx) - f0
+        diff = f0 + w * rise - alpha_t
+        weights = point_weights(xp[:, -1], TargetGrid(p, alpha_t), undershoot)
+        slope = torch.where(inside, rise / torch.where(inside, width, 1.0), 0.0)
+        ctx.save_for_backward(idx, w, slope, weights * diff)
+        ctx.knots = xp.shape[-1]
+        return (weights * diff * diff).sum(-1)
+
+    @staticmethod
+    def backward(ctx, g):
+        idx, w, slope, wdiff = ctx.saved_tensors
+        ga = (2.0 * g)[:, None] * wdiff  # dL/dalpha_q (B, M)
+        both = torch.cat([idx - 1, idx], -1)
+        grad_f = ga.new_zeros(ga.shape[0], ctx.knots)
+        grad_f.scatter_add_(-1, both, torch.cat([ga - ga * w, ga * w], -1))
+        gs = ga * slope
+        grad_x = ga.new_zeros(ga.shape[0], ctx.knots)
+        grad_x.scatter_add_(-1, both, torch.cat([gs * w - gs, -gs * w], -1))
+        return grad_x[:, 1:], grad_f[:, 1:], None, None, None
 
 
 def residuals(
@@ -206,9 +251,7 @@ def residuals(
     with torch.no_grad():
         gamma, h = to_design(raw, settings, hertz)
         delta, p_max = solve_delta(gamma, h, settings, target.p, sweep_fn=fn)
-        w = torch.where(target.p <= p_max[:, None], 1.0, undershoot)
-        norm = w.sum(-1, keepdim=True) * (target.alpha**2).mean(-1, keepdim=True)
-        weight = (w / norm).sqrt()  # (B, M)
+        weight = point_weights(p_max, target, undershoot).sqrt()  # (B, M)
     rep = raw.detach().repeat_interleave(m, 0).requires_grad_(True)
     g_rep, h_rep = to_design(rep, settings, hertz)
     alpha = at_delta(

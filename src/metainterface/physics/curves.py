@@ -247,17 +247,29 @@ def interp(xq: Tensor, xp: Tensor, *fps: Tensor) -> Tensor | tuple[Tensor, ...]:
     Returns one (B, Q) tensor per fp (a tuple if several); the knot search is shared.
     Zero-width knot intervals (repeated xp) are safe.
     """
-    k = xp.shape[-1]
-    idx = torch.searchsorted(xp.detach().contiguous(), xq.detach().contiguous()).clamp(1, k - 1)
-    x0, x1 = xp.gather(-1, idx - 1), xp.gather(-1, idx)
-    width = x1 - x0
-    has_width = width > 0
-    w = torch.where(has_width, ((xq - x0) / torch.where(has_width, width, 1.0)).clamp(0, 1), 0.0)
+    idx, w, _, _ = interp_weights(xq, xp)
     out = []
     for fp in fps:
         f0 = fp.gather(-1, idx - 1)
         out.append(f0 + w * (fp.gather(-1, idx) - f0))
     return out[0] if len(out) == 1 else tuple(out)
+
+
+def interp_weights(xq: Tensor, xp: Tensor) -> tuple[Tensor, Tensor, Tensor, Tensor]:
+    """The knots and weights of :func:`interp`: f(xq) = (1 - w) fp[idx - 1] + w fp[idx].
+
+    xq (B, Q), xp (B, K) -> idx (B, Q) in [1, K - 1], w (B, Q) in [0, 1] (differentiable in
+    xq and xp), ``inside`` (B, Q), where w is not clamped nor the interval empty (there only
+    does w depend on the knots), and the interval's width xp[idx] - xp[idx - 1] (B, Q).
+    """
+    k = xp.shape[-1]
+    idx = torch.searchsorted(xp.detach().contiguous(), xq.detach().contiguous()).clamp(1, k - 1)
+    x0, x1 = xp.gather(-1, idx - 1), xp.gather(-1, idx)
+    width = x1 - x0
+    has_width = width > 0
+    raw = (xq - x0) / torch.where(has_width, width, 1.0)
+    inside = has_width & (raw >= 0) & (raw <= 1)
+    return idx, torch.where(has_width, raw.clamp(0, 1), 0.0), inside, width
 
 
 def relative_l2(values: Tensor, reference: Tensor) -> Tensor:

@@ -120,13 +120,18 @@ def alpha_at(
     interacting model is run without its stiffness tangent, which alpha does not need (~25 %
     cheaper); ``exact`` (exact law only) solves P*(Delta) = p_star, which needs it.
     """
-    if check_physics(physics) == "independent":
-        fn = sweep
-    else:
-        fn = sweep_interacting if exact else _load_area_sweep
+    fn = alpha_sweep_for(physics, exact)
     return curves.alpha_at(
         gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta, sweep_fn=fn, exact=exact
     )
+
+
+def alpha_sweep_for(physics: str = DEFAULT_PHYSICS, exact: bool = False) -> SweepFunction:
+    """The sweep :func:`alpha_at` runs for a model: interpolated, the interacting one
+    without its stiffness tangent; ``exact`` needs S* and dP*/dDelta."""
+    if check_physics(physics) == "independent":
+        return sweep
+    return sweep_interacting if exact else _load_area_sweep
 
 
 def _load_area_sweep(
