@@ -126,8 +126,13 @@ class TargetGrid:
         return TargetGrid(self.p[index], self.alpha[index])
 
 
-def to_design(raw: Tensor, settings: CellSettings, hertz: bool = False) -> tuple[Tensor, Tensor]:
-    """Unbounded parameters (B, 2N - 1), or (B, N - 1) if ``hertz``, -> sorted (gamma, h)."""
+def to_design(
+    raw: Tensor, settings: CellSettings, hertz: bool = False, *, sort: bool = True
+) -> tuple[Tensor, Tensor]:
+    """Unbounded parameters (B, 2N - 1), or (B, N - 1) if ``hertz``, -> (gamma, h), sorted
+    by height with each gamma kept with its h. The losses skip the sort (``sort=False``)
+    where the model is a sum over independent asperities, whose order changes nothing; the
+    interacting model places asperity k in lattice cell k, so there order matters."""
     n = settings.n_asperities
     if hertz:
         r_h = raw
@@ -136,8 +141,15 @@ def to_design(raw: Tensor, settings: CellSettings, hertz: bool = False) -> tuple
         r_g, r_h = raw[:, :n], raw[:, n:]
         gamma = settings.gamma_min + (settings.gamma_max - settings.gamma_min) * torch.sigmoid(r_g)
     h = torch.cat([torch.zeros_like(r_h[:, :1]), settings.delta_max * nnf.softplus(r_h)], dim=-1)
+    if not sort:
+        return gamma, h
     h, order = torch.sort(h, dim=-1)
     return gamma.gather(-1, order), h
+
+
+def _placed(physics: str) -> bool:
+    """Whether the model's response depends on which lattice cell each asperity is in."""
+    return physics != "independent"
 
 
 #: How far inside the bounds :func:`from_design` puts a start: gamma at least this fraction
@@ -249,11 +261,11 @@ def residuals(
     b, m = target.p.shape
     fn = sweep_for(physics)
     with torch.no_grad():
-        gamma, h = to_design(raw, settings, hertz)
+        gamma, h = to_design(raw, settings, hertz, sort=_placed(physics))
         delta, p_max = solve_delta(gamma, h, settings, target.p, sweep_fn=fn)
         weight = point_weights(p_max, target, undershoot).sqrt()  # (B, M)
     rep = raw.detach().repeat_interleave(m, 0).requires_grad_(True)
-    g_rep, h_rep = to_design(rep, settings, hertz)
+    g_rep, h_rep = to_design(rep, settings, hertz, sort=_placed(physics))
     alpha = at_delta(
         g_rep,
         h_rep,
@@ -325,7 +337,12 @@ def polish(
         y = refine(raw[left], settings, rows, rs.polishing(), hertz, None, physics)
         with torch.no_grad():
             loss = masked_loss(
-                *to_design(y, settings, hertz), settings, rows, None, rs.undershoot_weight, physics
+                *to_design(y, settings, hertz, sort=_placed(physics)),
+                settings,
+                rows,
+                None,
+                rs.undershoot_weight,
+                physics,
             )
         better = loss < res.loss[left]
         x[left] = torch.where(better[:, None], y, x[left])
@@ -349,7 +366,7 @@ def refine(
     for kappa in rs.kappas():
 
         def fun(z: Tensor, idx: Tensor, kappa: float | None = kappa) -> Tensor:
-            gamma, h = to_design(z, settings, hertz)
+            gamma, h = to_design(z, settings, hertz, sort=_placed(physics))
             loss = masked_loss(
                 gamma, h, settings, target.rows(idx), kappa, rs.undershoot_weight, physics
             )

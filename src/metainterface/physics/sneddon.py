@@ -24,7 +24,7 @@ from torch.nn import functional as nnf
 
 def log_kappa(gamma: Tensor) -> Tensor:
     """log kappa(gamma), kappa = sqrt(pi) Gamma(gamma/2 + 1) / Gamma((gamma + 1)/2), via lgamma."""
-    return 0.5 * math.log(math.pi) + torch.lgamma(gamma / 2 + 1) - torch.lgamma((gamma + 1) / 2)
+    return _lgamma_ratio(gamma) + 0.5 * math.log(math.pi)
 
 
 def kappa(gamma: Tensor) -> Tensor:
@@ -34,16 +34,23 @@ def kappa(gamma: Tensor) -> Tensor:
 
 def log_kc(gamma: Tensor, radius: float = 1.0) -> Tensor:
     """log(kappa(gamma) * c(gamma)) with c = 1 / (2 R^(gamma - 1)); shape of ``gamma``."""
-    return log_kappa(gamma) - math.log(2.0) - (gamma - 1) * math.log(radius)
+    # the constants folded into one addition, the radius term only where R != 1: the
+    # refinement computes this at every evaluation, where each operation costs ~5 us
+    out = _lgamma_ratio(gamma) + (0.5 * math.log(math.pi) - math.log(2.0))
+    return out if radius == 1.0 else out - (gamma - 1) * math.log(radius)
 
 
 def dlog_kc(gamma: Tensor, radius: float = 1.0) -> Tensor:
     """d log(kappa c) / d gamma = psi(gamma/2 + 1)/2 - psi((gamma + 1)/2)/2 - log R."""
-    return (
-        0.5 * torch.special.digamma(gamma / 2 + 1)
-        - 0.5 * torch.special.digamma((gamma + 1) / 2)
-        - math.log(radius)
-    )
+    half = 0.5 * gamma
+    out = 0.5 * (torch.special.digamma(half + 1.0) - torch.special.digamma(half + 0.5))
+    return out if radius == 1.0 else out - math.log(radius)
+
+
+def _lgamma_ratio(gamma: Tensor) -> Tensor:
+    """log Gamma(gamma/2 + 1) - log Gamma((gamma + 1)/2)."""
+    half = 0.5 * gamma
+    return torch.lgamma(half + 1.0) - torch.lgamma(half + 0.5)
 
 
 def shape_constant(gamma: Tensor, radius: float = 1.0) -> Tensor:
