@@ -23,7 +23,7 @@ import numpy as np
 import torch
 
 from metainterface.design import builtin_target, design
-from metainterface.design.refine import RefineSettings
+from metainterface.design.refine import POLISH_METHODS, RefineSettings
 from metainterface.design.targets import Target, design_targets
 from metainterface.physics import CellSettings
 
@@ -76,7 +76,7 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=4, help="seeds of the quality comparison")
     ap.add_argument(
         "--polish",
-        choices=["levmar", "lbfgs"],
+        choices=POLISH_METHODS,
         default=RefineSettings().polish_method,
         help="the polish's method (RefineSettings.polish_method), to compare them",
     )

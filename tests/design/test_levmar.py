@@ -118,3 +118,11 @@ def test_the_polish_is_never_worse_than_the_lbfgs_polish():
     lbfgs_only = loss(refine(raw, s, grid, rs.polishing()))
     assert (both <= lbfgs_only).all()
     assert (both < loss(raw)).all()
+
+
+def test_an_unknown_polish_method_is_refused_by_name():
+    from metainterface.design.refine import RefineSettings
+    from metainterface.errors import MetainterfaceError
+
+    with pytest.raises(MetainterfaceError, match="polish_method must be one of levmar, lbfgs"):
+        RefineSettings(polish_method="newton")

@@ -259,17 +259,17 @@ def interp_weights(xq: Tensor, xp: Tensor) -> tuple[Tensor, Tensor, Tensor, Tens
     """The knots and weights of :func:`interp`: f(xq) = (1 - w) fp[idx - 1] + w fp[idx].
 
     xq (B, Q), xp (B, K) -> idx (B, Q) in [1, K - 1], w (B, Q) in [0, 1] (differentiable in
-    xq and xp), ``inside`` (B, Q), where w is not clamped nor the interval empty (there only
-    does w depend on the knots), and the interval's width xp[idx] - xp[idx - 1] (B, Q).
+    xq and xp), the interval's width xp[idx] - xp[idx - 1] (B, Q), and the unclamped
+    ratio (xq - xp[idx - 1]) / width (B, Q; any value where the width is 0): w depends on
+    the knots only where the width is positive and the ratio in [0, 1].
     """
     k = xp.shape[-1]
     idx = torch.searchsorted(xp.detach().contiguous(), xq.detach().contiguous()).clamp(1, k - 1)
     x0, x1 = xp.gather(-1, idx - 1), xp.gather(-1, idx)
     width = x1 - x0
     has_width = width > 0
-    raw = (xq - x0) / torch.where(has_width, width, 1.0)
-    inside = has_width & (raw >= 0) & (raw <= 1)
-    return idx, torch.where(has_width, raw.clamp(0, 1), 0.0), inside, width
+    ratio = (xq - x0) / torch.where(has_width, width, 1.0)
+    return idx, torch.where(has_width, ratio.clamp(0, 1), 0.0), width, ratio
 
 
 def relative_l2(values: Tensor, reference: Tensor) -> Tensor:
