@@ -22,10 +22,11 @@ import time
 import numpy as np
 import torch
 
-from metainterface.design import builtin_target, design
-from metainterface.design.refine import POLISH_METHODS, RefineSettings
-from metainterface.design.targets import Target, design_targets
+from metainterface.inverse import builtin_target, design
+from metainterface.inverse.refine import POLISH_METHODS, RefineSettings
+from metainterface.inverse.targets import Target, design_targets
 from metainterface.physics import CellSettings
+from metainterface.runtime import tune_allocator
 
 
 def realisable_targets(count: int, seed: int = 7) -> list[Target]:
@@ -81,6 +82,7 @@ def main() -> None:
         help="the polish's method (RefineSettings.polish_method), to compare them",
     )
     args = ap.parse_args()
+    tune_allocator()  # as the CLI does
     rs = RefineSettings(polish_method=args.polish)
     targets = [builtin_target(n) for n in ("saturating", "bilinear", "linear")]
     design(targets[:1], "surrogate")  # warm-up (imports, model load)

@@ -12,6 +12,7 @@ import numpy as np
 import torch
 
 from metainterface.physics import CellSettings, curves_numpy
+from metainterface.runtime import tune_allocator
 
 
 def main() -> None:
@@ -19,6 +20,7 @@ def main() -> None:
     ap.add_argument("--designs", type=int, default=100_000)
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
+    tune_allocator()  # as the CLI does
     s = CellSettings()
     rng = np.random.default_rng(0)
     gamma = rng.uniform(s.gamma_min, s.gamma_max, (args.designs, s.n_asperities))

@@ -24,6 +24,7 @@ import torch  # noqa: E402
 
 from metainterface.data import generate_dataset  # noqa: E402
 from metainterface.physics import CellSettings  # noqa: E402
+from metainterface.runtime import tune_allocator  # noqa: E402
 
 t_import = time.perf_counter() - t_import
 
@@ -40,6 +41,7 @@ def main() -> None:
     parser.add_argument("--out", help="folder for the file (default: a temporary one)")
     parser.add_argument("--threads", type=int, help="torch threads (default: torch's own)")
     args = parser.parse_args()
+    tune_allocator()  # as the CLI does
     if args.threads:
         torch.set_num_threads(args.threads)
     settings = CellSettings()

@@ -31,9 +31,9 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from metainterface.physics.forward import alpha_at, alpha_at_loads
 
 from metainterface.physics import CellSettings, Design, interp, sweep
-from metainterface.physics.forward import alpha_at, alpha_at_loads
 from metainterface.physics.interaction import load_area_interacting, sweep_interacting
 from metainterface.runtime import tune_allocator
 

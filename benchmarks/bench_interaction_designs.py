@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from metainterface.design import builtin_target, design
-from metainterface.io.atomic import write_text
+from metainterface._files.atomic import write_text
+from metainterface.inverse import builtin_target, design
 from metainterface.physics import CellSettings, Design
 from metainterface.runtime import tune_allocator
 from metainterface.validation import plan_validation

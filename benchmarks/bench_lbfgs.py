@@ -24,7 +24,8 @@ from types import ModuleType
 import torch
 from torch import Tensor
 
-from metainterface.design import lbfgs
+from metainterface.inverse import lbfgs
+from metainterface.runtime import tune_allocator
 
 OFF = {"tol_grad": -1.0, "tol_change": -1.0, "tol_loss": -float("inf")}
 
@@ -103,6 +104,7 @@ def main() -> None:
     ap.add_argument("--history", type=int, default=10)
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args()
+    tune_allocator()  # as the CLI does
     torch.set_num_threads(1)
     mods = {"new": lbfgs} if args.old is None else {"old": load(args.old), "new": lbfgs}
     print(

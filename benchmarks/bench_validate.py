@@ -16,6 +16,7 @@ import numpy as np
 
 from metainterface.io import load_design
 from metainterface.physics import Design
+from metainterface.runtime import tune_allocator
 from metainterface.validation import available_cpus, plan_validation
 
 SMALL = Design(gamma=np.array([1.8, 2.6, 3.3, 4.0]), h=np.array([0.0, 0.003, 0.006, 0.01]))
@@ -62,6 +63,7 @@ def main() -> None:
     ap.add_argument("--only", choices=("small", "large"))
     ap.add_argument("--scaling", action="store_true", help="also time one solve vs grid size")
     args = ap.parse_args()
+    tune_allocator()  # as the CLI does
     if args.only != "large":
         run("small", SMALL, 256, 8, args.jobs, 3)
     if args.only != "small":

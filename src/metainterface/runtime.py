@@ -2,12 +2,11 @@
 
 glibc hands every freed block above its mmap threshold (128 KiB at first, adapting up to
 32 MiB) back to the kernel, and the next allocation of that size page-faults it in again,
-zero-filled. A training step of the surrogate allocates ~60 such (batch, N, K) temporaries:
-measured here, an epoch took ~400,000 minor page faults and about a quarter of its time
-went to them; 100,000 exact curves took 2.7 s instead of 1.2 s. Keeping freed memory in the
-heap removes them; the price is that the process keeps its peak heap (a few hundred MB for
-training) until it exits. The CLI, ``train``, ``design`` and ``curves_numpy`` (so dataset
-generation) call :func:`tune_allocator`.
+zero-filled; a training step allocates dozens of such temporaries. Keeping freed memory in
+the heap removes those faults (``benchmarks/bench_train.py`` reports them); the price is
+that the process keeps its peak heap until it exits. So it is a decision for the process,
+made at entry points: the CLI and the benchmarks call :func:`tune_allocator`, a notebook
+user may call ``metainterface.tune_allocator()``; no library function does.
 """
 
 from __future__ import annotations

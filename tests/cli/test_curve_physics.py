@@ -5,8 +5,8 @@ from importlib.resources import files
 import numpy as np
 import pytest
 
+import metainterface as mi
 from metainterface.cli import main
-from metainterface.physics.forward import PHYSICS
 
 EXAMPLE = str(files("metainterface") / "examples" / "example_design.json")
 
@@ -28,7 +28,7 @@ def test_curve_physics_option(tmp_path, capsys):
     assert b["alpha"][0] == 0 and np.all(np.diff(b["alpha"]) >= 0)
     assert np.all(np.isfinite(b["stiffness"]))
     assert np.abs(b["alpha"] - a["alpha"]).max() > 1e-4 * a["alpha"].max()
-    assert '"physics": "interacting"' in inter.read_text().splitlines()[0]
+    assert '"model": "interacting"' in inter.read_text().splitlines()[0]
 
 
 def test_curve_physics_choices(tmp_path, capsys):
@@ -41,4 +41,4 @@ def test_curve_physics_choices(tmp_path, capsys):
 
     sub = build_parser()._subparsers._group_actions[0].choices["curve"]
     (opt,) = [a for a in sub._actions if a.dest == "physics"]
-    assert tuple(opt.choices) == PHYSICS and opt.default == "independent"
+    assert tuple(opt.choices) == tuple(mi.MODELS) and opt.default == "independent"

@@ -11,8 +11,8 @@ from PIL import Image
 
 import metainterface
 from metainterface.errors import MetainterfaceError
-from metainterface.io import load_design
 from metainterface.io.export import export_design, format_for, height_patch, parse_tiles
+from metainterface.physics import Design
 from metainterface.validation.heightmap import height_map
 
 EXAMPLE = Path(metainterface.__file__).parent / "examples" / "example_design.json"
@@ -22,7 +22,7 @@ GRID = 24  # points per cell side: small and fast, a multiple of n = 3
 
 @pytest.fixture(scope="module")
 def design():
-    return load_design(EXAMPLE)
+    return Design.load(EXAMPLE)
 
 
 def test_npy_is_the_validation_height_map_times_r(design, tmp_path):

@@ -8,15 +8,6 @@ import torch
 
 from metainterface.errors import MetainterfaceError
 from metainterface.physics import CellSettings, Design, curve, curves, interp, kappa, sweep
-from metainterface.physics.forward import (
-    PHYSICS,
-    alpha_at,
-    alpha_at_loads,
-    check_physics,
-    curve_for,
-    design_sweep_for,
-    sweep_for,
-)
 from metainterface.physics.interaction import (
     interaction,
     load_area_interacting,
@@ -24,6 +15,7 @@ from metainterface.physics.interaction import (
     periodic_kernel,
     sweep_interacting,
 )
+from metainterface.physics.models import MODELS, Independent, Interacting, get_model
 
 F64 = torch.float64
 S = CellSettings()
@@ -305,7 +297,7 @@ def test_gradients_finite_at_first_contact(dtype, smooth):
     h = grid[[0, 0, 5, 17, 17, 40, 90, 127, 60]][None].clone()
     g.requires_grad_()
     h.requires_grad_()
-    c = curve_for(g, h, S, physics="interacting", smooth=smooth)
+    c = Interacting().curve(g, h, S, smooth=smooth)
     loss = c.alpha_hat.sum() + c.stiffness_hat.sum() + c.p_star_max.log().sum()
     loss.backward()
     assert torch.isfinite(g.grad).all() and torch.isfinite(h.grad).all()
@@ -314,41 +306,44 @@ def test_gradients_finite_at_first_contact(dtype, smooth):
 
 def test_float32_matches_float64():
     g, h = random_designs(8, seed=7)
-    c64 = curve_for(g, h, S, physics="interacting")
-    c32 = curve_for(g.float(), h.float(), S, physics="interacting")
+    c64 = Interacting().curve(g, h, S)
+    c32 = Interacting().curve(g.float(), h.float(), S)
     np.testing.assert_allclose(c32.alpha_hat, c64.alpha_hat, atol=5e-5)
     np.testing.assert_allclose(c32.p_star_max, c64.p_star_max, rtol=1e-5)
 
 
-# --- dispatcher ------------------------------------------------------------------------
+# --- the registry ----------------------------------------------------------------------
 
 
-def test_dispatcher():
-    assert PHYSICS == ("independent", "interacting")
-    assert sweep_for("independent") is sweep
-    assert sweep_for("interacting") is sweep_interacting
-    with pytest.raises(MetainterfaceError, match="physics must be one of"):
-        check_physics("coupled")
+def test_registry():
+    assert tuple(MODELS) == ("independent", "interacting")
+    assert get_model() == Independent() and get_model("interacting") == Interacting()
+    with pytest.raises(MetainterfaceError, match="model must be one of"):
+        get_model("coupled")
     g, h = random_designs(2, seed=8)
-    np.testing.assert_allclose(curve_for(g, h, S).alpha, curve(g, h, S).alpha)
+    np.testing.assert_array_equal(Independent().sweep(g, h, S).alpha, sweep(g, h, S).alpha)
+    np.testing.assert_array_equal(
+        Interacting().sweep(g, h, S).alpha, sweep_interacting(g, h, S).alpha
+    )
+    np.testing.assert_allclose(get_model().curve(g, h, S).alpha, curve(g, h, S).alpha)
     sw = sweep_interacting(g, h, S, smooth=1e3)
     delta, p, a = load_area_interacting(g, h, S, smooth=1e3)
     np.testing.assert_array_equal(delta, sw.delta)
     np.testing.assert_array_equal(p, sw.p_star)
     np.testing.assert_array_equal(a, sw.alpha)
     d = Design(gamma=g[0].numpy(), h=h[0].numpy())
-    sw = design_sweep_for(d, physics="interacting", n_delta=32)
+    sw = Interacting().design_sweep(d, n_delta=32)
     assert sw.alpha.shape == (1, 32)
 
 
 def test_alpha_at_matches_the_design_convention():
     g, h = random_designs(3, seed=9)
     p = torch.linspace(0, 0.004, 50, dtype=F64)[None].expand(3, -1)
-    a, p_max = alpha_at(g, h, S, p)
+    a, p_max = Independent().alpha_at(g, h, S, p)
     ref = curves.alpha_at(g, h, S, p)
     np.testing.assert_array_equal(a, ref[0])
     np.testing.assert_array_equal(p_max, ref[1])
-    a, p_max = alpha_at(g, h, S, p, physics="interacting")
+    a, p_max = Interacting().alpha_at(g, h, S, p)
     sw = sweep_interacting(g, h, S)
     np.testing.assert_allclose(p_max, sw.p_star[:, -1])
     beyond = p > p_max[:, None]
@@ -366,15 +361,15 @@ def test_alpha_at_loads_extends_the_sweep():
     g, h = g[i : i + 1], h[i : i + 1]
     assert float(top_int[i]) > 1.01 * float(top_ind[i])
     loads = top_int[i] * torch.tensor([[0.25, 0.5, 0.75, 1.0]], dtype=F64)
-    a_ind = alpha_at_loads(g, h, S, loads)
+    a_ind = Independent().alpha_at_loads(g, h, S, loads)
     long = torch.linspace(0, 2 * S.delta_max, 8193, dtype=F64)
     dense = sweep(g, h, S, delta=long)
     np.testing.assert_allclose(a_ind, interp(loads, dense.p_star, dense.alpha), rtol=1e-5)
-    a_int = alpha_at_loads(g, h, S, loads, physics="interacting")
+    a_int = Interacting().alpha_at_loads(g, h, S, loads)
     ref = sweep_interacting(g, h, S, delta=long)
     np.testing.assert_allclose(a_int, interp(loads, ref.p_star, ref.alpha), rtol=1e-5)
     with pytest.raises(MetainterfaceError, match="not reached"):
-        alpha_at_loads(g, h, S, loads * 1e6, max_extend=1)
+        Independent().alpha_at_loads(g, h, S, loads * 1e6, max_extend=1)
 
 
 def test_curvature_lowers_blunt_uniform_cells():

@@ -2,22 +2,19 @@
 
 import json
 import math
+from dataclasses import replace
 from importlib.resources import files
 
 import numpy as np
 import pytest
 
+from metainterface import validate_many
 from metainterface.errors import MetainterfaceError
-from metainterface.io import load_design, save_design
 from metainterface.physics import CellSettings, Design
-from metainterface.validation import (
-    solve_path,
-    validate_design,
-    validate_many,
-)
+from metainterface.physics.models import MODELS, Independent, get_model
+from metainterface.validation import solve_path, validate_design
 from metainterface.validation.bem import contact_area
 from metainterface.validation.heightmap import height_map
-from metainterface.validation.models import model_curve
 
 HERTZ = Design(gamma=np.array([2.0]), h=np.array([0.0]), settings=CellSettings(n_asperities=1))
 
@@ -38,7 +35,7 @@ def test_single_hertz_asperity_matches_the_closed_form(hertz):
     np.testing.assert_allclose(a_bem, a, rtol=0.02)
     np.testing.assert_allclose(hertz.p_max, p0, rtol=0.02)
     np.testing.assert_allclose(hertz.alpha_bem, hertz.alpha_model, rtol=0.03)
-    assert hertz.p_star[-1] == pytest.approx(model_curve(HERTZ).p_star_max)
+    assert hertz.p_star[-1] == pytest.approx(get_model().model_curve(HERTZ).p_star_max)
     assert (hertz.residual <= 1e-11).all()
 
 
@@ -60,13 +57,15 @@ def test_contact_is_at_the_tip_not_the_cell_corners(hertz):
     assert _contact_distance(flipped.pressure, hm.spacing, centre) > hm.cell_side / 3
 
 
-EXAMPLE = load_design(files("metainterface") / "examples" / "example_design.json")
+EXAMPLE = Design.load(files("metainterface") / "examples" / "example_design.json")
 
 
 def test_quick_three_by_three_cell():
     res = validate_design(EXAMPLE, 96, 3, name="example")
     assert res.grid == 96 and res.pressure.shape == (96, 96)
-    np.testing.assert_allclose(res.p_star, model_curve(EXAMPLE).p_star_max * np.arange(1, 4) / 3)
+    np.testing.assert_allclose(
+        res.p_star, get_model().model_curve(EXAMPLE).p_star_max * np.arange(1, 4) / 3
+    )
     assert np.abs(res.rel_err).max() < 0.08  # 8 grid points per a_max only
     np.testing.assert_allclose(res.asperity_alpha_bem.sum(1), res.alpha_bem, rtol=1e-12)
     np.testing.assert_allclose(res.asperity_alpha_bem, res.asperity_alpha_model, atol=2e-3)
@@ -87,7 +86,7 @@ def test_no_convergence_names_the_load_and_residual():
 
 
 def test_bad_loads_and_jobs():
-    top = model_curve(HERTZ).p_star_max
+    top = get_model().model_curve(HERTZ).p_star_max
     with pytest.raises(MetainterfaceError, match="beyond what the design reaches"):
         validate_design(HERTZ, 64, [0.5 * top, 1.01 * top])
     with pytest.raises(MetainterfaceError, match="not > 0"):
@@ -96,34 +95,42 @@ def test_bad_loads_and_jobs():
         validate_design(HERTZ, 64, 0)
     with pytest.raises(MetainterfaceError, match="jobs"):
         validate_design(HERTZ, 64, 2, jobs=0)
-    with pytest.raises(MetainterfaceError, match="physics must be one of"):
-        validate_design(HERTZ, 64, 2, physics="nope")
+    with pytest.raises(MetainterfaceError, match="model must be one of"):
+        validate_design(HERTZ, 64, 2, model="nope")
+
+
+class Half(Independent):
+    """A model of half the paper's contact area at every load (a test double)."""
+
+    name = "half"
+
+    def sweep(self, gamma, h, settings, **kw):
+        sw = super().sweep(gamma, h, settings, **kw)
+        return replace(sw, alpha=0.5 * sw.alpha, stiffness=2.0 * sw.stiffness)
+
+    def asperity_sweep(self, gamma, h, settings, **kw):
+        sw, per = super().asperity_sweep(gamma, h, settings, **kw)
+        return replace(sw, alpha=0.5 * sw.alpha), 0.5 * per
 
 
 def test_a_second_model_plugs_in(monkeypatch):
-    from metainterface.validation import models
-
-    def stiffer(design):
-        base = models.independent_asperities(design)
-        return models.ModelCurve(base.p_star, 0.5 * base.alpha, None)
-
-    monkeypatch.setitem(models.MODELS, "half", stiffer)
-    res = validate_design(HERTZ, 64, 2, physics="half")
+    monkeypatch.setitem(MODELS, "half", Half())
+    res = validate_design(HERTZ, 64, 2, model="half")
     ref = validate_design(HERTZ, 64, 2)
     np.testing.assert_allclose(res.alpha_model, 0.5 * ref.alpha_model)
-    assert res.asperity_alpha_model is None and res.physics == "half"
+    assert res.model.name == "half" and set(res.alpha_by_model) == {*MODELS}
 
 
 def test_many_designs_write_as_they_go_and_resume(tmp_path):
     folder = tmp_path / "designs"
-    save_design(folder / "a.json", HERTZ)
+    HERTZ.save(folder / "a.json")
     out = tmp_path / "sweep"
     first = validate_many(folder, out, grid=64, loads=2, progress=False)
     assert set(first) == {"a"}
     stamp = (out / "a" / "result.json").stat().st_mtime_ns
     for name, gamma in (("b", 1.8), ("c", 3.0), ("d", 4.0)):
         other = Design(gamma=np.array([gamma]), h=np.array([0.0]), settings=HERTZ.settings)
-        save_design(folder / f"{name}.json", other)
+        other.save(folder / f"{name}.json")
     every = validate_many(folder, out, grid=64, loads=2, jobs=2, progress=False)
     assert list(every) == ["a", "b", "c", "d"]
     assert (out / "a" / "result.json").stat().st_mtime_ns == stamp  # resumed, not redone

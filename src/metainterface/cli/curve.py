@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from metainterface.cli.common import positive_float, positive_int
+from metainterface.physics.models import DEFAULT_MODEL, MODELS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,8 +25,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--physics",
-        choices=("independent", "interacting"),
-        default="independent",
+        choices=tuple(MODELS),
+        default=DEFAULT_MODEL,
         help="forward model: the paper's independent asperities (default) or with their "
         "elastic interaction through the periodic lattice",
     )
@@ -35,32 +36,27 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from metainterface.io import load_design, write_columns
-    from metainterface.physics.forward import design_sweep_for
+    import metainterface as mi
+    from metainterface._files import write_columns
 
-    design = load_design(args.design)
-    sw = design_sweep_for(design, physics=args.physics, n_delta=args.steps, smooth=args.smooth)
+    c = mi.curve(args.design, model=args.physics, steps=args.steps, smooth=args.smooth)
     write_columns(
         args.out,
-        {
-            "delta": sw.delta.numpy(),
-            "p_star": sw.p_star[0].numpy(),
-            "alpha": sw.alpha[0].numpy(),
-            "stiffness": sw.stiffness[0].numpy(),
-        },
+        c.columns(),
         command="curve",
         design=args.design,
         steps=args.steps,
         smooth=args.smooth,
-        physics=args.physics,
-        cell=design.settings.to_dict(),
+        model=c.model,
     )
     if args.plot:
+        from pathlib import Path
+
         from metainterface.plots import plot_curve, save_figure
 
-        save_figure(plot_curve(sw, title=args.design), args.plot, command="curve")
+        save_figure(plot_curve(c, title=Path(args.design).name), args.plot, command="curve")
     print(
-        f"{args.out}: {args.steps} points ({args.physics}), "
-        f"P*_max = {float(sw.p_star[0, -1]):.4g}, alpha_max = {float(sw.alpha[0, -1]):.4g}"
+        f"{args.out}: {args.steps} points ({c.model}), "
+        f"P*_max = {c.p_star_max:.4g}, alpha_max = {c.alpha_max:.4g}"
     )
     return 0

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 
 from metainterface.cli.common import positive_int
+from metainterface.inverse.pipeline import METHODS
+from metainterface.physics.models import DEFAULT_MODEL, MODELS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -12,8 +14,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "design",
         help="design a unit cell for a target contact law (the main job)",
         description="Zero-shot prediction by the shipped surrogate, then multi-stage L-BFGS "
-        "refinement (or a multistart / Hertz-only baseline). Writes, per target, design.json, "
-        "target.csv, curve.csv and design.png under --out.",
+        "refinement (or a multistart / Hertz-only baseline). Writes design.json, target.csv, "
+        "curve.csv and design.png into --out (one folder per target when there are several).",
     )
     src = p.add_argument_group("targets (one or more)")
     src.add_argument(
@@ -43,7 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     phys.add_argument("--area", help="nominal area of the whole interface, e.g. 4cm2")
     phys.add_argument("--total-force", help="total normal force, e.g. 10N (number of cells)")
     p.add_argument("--out", required=True, help="output folder")
-    p.add_argument("--method", choices=("surrogate", "multistart", "hertz"), default="surrogate")
+    p.add_argument("--method", choices=METHODS, default="surrogate")
     p.add_argument("--refine", choices=("lbfgs", "none"), default="lbfgs")
     p.add_argument(
         "--compare",
@@ -51,7 +53,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="run all three methods and draw them together (paper fig. 5)",
     )
     p.add_argument("--starts", type=positive_int, default=50, help="random starts (baselines)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="seed of every random draw (default 0)")
     p.add_argument("--model", help="surrogate model file (default: the shipped one)")
     p.add_argument(
         "--hedge",
@@ -71,10 +73,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--physics",
-        choices=("independent", "interacting"),
-        default="independent",
+        choices=tuple(MODELS),
+        default=DEFAULT_MODEL,
         help="forward model to refine and measure with (default: the paper's independent one)",
     )
+    space = p.add_argument_group(
+        "design space (default: the paper's cell, which the shipped surrogate was trained for; "
+        "another cell is designed by multistart)"
+    )
+    space.add_argument("--n-asperities", type=int, metavar="N", help="a perfect square (9)")
+    space.add_argument("--gamma-min", type=float, help="smallest shape exponent (1.8)")
+    space.add_argument("--gamma-max", type=float, help="largest shape exponent (4.0)")
+    space.add_argument("--delta-max", type=float, help="largest indentation in units of R (0.02)")
     p.add_argument(
         "--max-pressure",
         help="peak contact pressure limit: p/E* (number) or a stress with --modulus",
@@ -82,108 +92,104 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _targets(args: argparse.Namespace):
-    from metainterface.design import builtin_target, target_from_csv
-    from metainterface.errors import MetainterfaceError
+def _targets(args: argparse.Namespace) -> list:
+    import metainterface as mi
 
-    targets = [builtin_target(n) for n in args.target]
-    targets += [target_from_csv(f) for f in args.target_csv]
-    friction = None
+    targets = [mi.Target.builtin(n) for n in args.target]
+    targets += [mi.Target.from_csv(f) for f in args.target_csv]
     if args.friction_csv:
-        from metainterface.design.targets import Target
-        from metainterface.io.friction import friction_target_from_options
-
-        friction = friction_target_from_options(
-            args.friction_csv,
-            shear_strength=args.shear_strength,
-            modulus=args.modulus,
-            radius=args.radius,
-            area=args.area,
-        )
-        from pathlib import Path
-
+        given = {
+            "--shear-strength": args.shear_strength,
+            "--modulus": args.modulus,
+            "--radius": args.radius,
+            "--area": args.area,
+        }
+        missing = [name for name, value in given.items() if value is None]
+        if missing:
+            raise mi.MetainterfaceError(
+                "--friction-csv needs --shear-strength, --modulus, --radius and --area "
+                f"(missing {', '.join(missing)})"
+            )
         targets.append(
-            Target(
-                Path(args.friction_csv).stem,
-                friction.p_star,
-                friction.alpha,
-                None,
+            mi.Target.from_friction(
                 args.friction_csv,
-                {"friction": friction.record()},
+                shear_strength=args.shear_strength,
+                modulus=args.modulus,
+                radius=args.radius,
+                area=args.area,
             )
         )
     if not targets:
-        raise MetainterfaceError("give at least one --target, --target-csv or --friction-csv")
-    names = [t.name for t in targets]
-    if len(set(names)) != len(names):
-        raise MetainterfaceError(f"target names must be distinct, got {', '.join(names)}")
+        raise mi.MetainterfaceError("give at least one --target, --target-csv or --friction-csv")
     return targets
 
 
 def run(args: argparse.Namespace) -> int:
     import sys
-    from pathlib import Path
 
-    from metainterface.design import design, reachability_warnings
-    from metainterface.io.units import parse_pressure, parse_pressure_limit
+    import metainterface as mi
 
     targets = _targets(args)
-    e_star = parse_pressure(args.modulus, option="--modulus") if args.modulus else None
-    extra = None
-    limit = None
-    if args.max_pressure:
-        from metainterface.physics.limits import pressure_penalty
-
-        limit = parse_pressure_limit(args.max_pressure, e_star=e_star)
-
-        def extra(gamma, h, settings, limit=limit):
-            return 10.0 * pressure_penalty(gamma, h, settings, limit)
-
-    methods = ["surrogate", "multistart", "hertz"] if args.compare else [args.method]
-    all_results = [
-        design(
-            targets,
-            method,
-            refine_designs=args.refine == "lbfgs",
-            model_path=args.model,
-            starts=args.starts,
-            seed=args.seed,
-            extra_loss=extra,
-            physics=args.physics,
-            hedge=args.hedge if method == "surrogate" else 0,
-            fallback=args.fallback if method == "surrogate" else 0,
+    options = dict(
+        refine=args.refine == "lbfgs",
+        surrogate=args.model,
+        starts=args.starts,
+        seed=args.seed,
+        model=args.physics,
+        hedge=args.hedge,
+        fallback=args.fallback,
+        max_pressure=args.max_pressure,
+        modulus=args.modulus,
+        radius=args.radius,
+        total_force=args.total_force,
+        area=args.area if args.total_force is None else None,
+        settings=_settings(args),
+        meta=_command(args),
+    )
+    if args.compare:
+        by_method = mi.compare(targets, out=args.out, **options)
+        results = [r for m in by_method.values() for r in m]
+    else:  # one target: its files directly in --out; several: one folder each
+        made = mi.design(
+            targets[0] if len(targets) == 1 else targets,
+            method=args.method,
+            out=args.out,
+            **options,
         )
-        for method in methods
-    ]
-    for t, r in zip(targets, all_results[0], strict=True):
-        for w in reachability_warnings(t, r.settings):
-            print(f"warning: {w}", file=sys.stderr)
-    from metainterface.io.report import pressure_check, write_design_outputs
-    from metainterface.physics.cell import Design
-
-    out = Path(args.out)
-    rows = []
-    for i, t in enumerate(targets):
-        per_method = [res[i] for res in all_results]
-        for r in per_method:
-            folder = out / t.name if len(methods) == 1 else out / t.name / r.method
-            check = None
-            if limit is not None:
-                check = pressure_check(
-                    Design(gamma=r.gamma, h=r.h, settings=r.settings), limit, e_star
-                )
-                print(f"{t.name} ({r.method}): {check.summary()}")
-            write_design_outputs(folder, r, args=args, pressure=check)
-            rows.append((t.name, r.method, r.initial_error, r.error, r.seconds, folder))
-        if args.compare:
-            from metainterface.plots import plot_comparison, save_figure
-
-            save_figure(
-                plot_comparison([per_method]),
-                out / t.name / "compare.png",
-                command="design --compare",
-            )
-    print(f"{'target':<14}{'method':<12}{'zero-shot':>10}{'error':>9}{'seconds':>9}  output")
-    for name, method, e0, e, sec, folder in rows:
-        print(f"{name:<14}{method:<12}{100 * e0:>9.2f}%{100 * e:>8.2f}%{sec:>9.2f}  {folder}")
+        results = made if isinstance(made, list) else [made]
+    for r in results:
+        for note in r.notes:
+            print(f"warning: {note}", file=sys.stderr)
+        if r.pressure is not None:
+            print(f"{r.target.name} ({r.method}): {r.pressure.summary()}")
+    width = max(len("target"), *(len(r.target.name) for r in results)) + 2
+    print(f"{'target':<{width}}{'method':<12}{'zero-shot':>11}{'error':>11}{'seconds':>9}")
+    for r in results:
+        print(
+            f"{r.target.name:<{width}}{r.method:<12}{100 * r.initial_error:>9.3g} %"
+            f"{100 * r.error:>9.3g} %{r.seconds:>9.2f}"
+        )
+    print(f"written to {args.out}")
     return 0
+
+
+def _settings(args: argparse.Namespace):
+    """The cell from the design-space options, or None for the surrogate's own cell."""
+    import metainterface as mi
+
+    given = {
+        k: v
+        for k, v in (
+            ("n_asperities", args.n_asperities),
+            ("gamma_min", args.gamma_min),
+            ("gamma_max", args.gamma_max),
+            ("delta_max", args.delta_max),
+        )
+        if v is not None
+    }
+    return mi.CellSettings(**given) if given else None
+
+
+def _command(args: argparse.Namespace) -> dict:
+    """The options as given, recorded in design.json."""
+    return {k: v for k, v in vars(args).items() if k != "func"}

@@ -22,18 +22,13 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import json
 
-    from metainterface.data import load_dataset
-    from metainterface.io import provenance, write_text
-    from metainterface.surrogate.checkpoint import default_model_path, load_model
-    from metainterface.surrogate.data import split_of
-    from metainterface.surrogate.evaluate import evaluate, format_table, predict_split
-    from metainterface.surrogate.loss import weights_of
+    import metainterface as mi
+    from metainterface._files import provenance, write_text
+    from metainterface.surrogate.checkpoint import default_model_path
+    from metainterface.surrogate.evaluate import format_table
 
     model_path = args.model or default_model_path()
-    model, settings, config = load_model(model_path)
-    ds = load_dataset(args.dataset, settings)
-    train, test = split_of(ds, "train"), split_of(ds, "test")
-    result = evaluate(model, train, test, settings, weights_of(config))
+    result = mi.evaluate_surrogate(args.dataset, model_path)
     print(format_table(result))
     if args.out:
         record = {
@@ -44,9 +39,15 @@ def run(args: argparse.Namespace) -> int:
         }
         write_text(args.out, json.dumps(record, indent=2) + "\n")
     if args.plot:
+        from metainterface.data import load_dataset
         from metainterface.plots import plot_reconstructions, save_figure
+        from metainterface.surrogate.checkpoint import load_model
+        from metainterface.surrogate.data import split_of
+        from metainterface.surrogate.evaluate import predict_split
 
-        pred = predict_split(model, test, settings)
+        model, settings, _ = load_model(model_path)
+        ds = load_dataset(args.dataset, settings)
+        pred = predict_split(model, split_of(ds, "test"), settings)
         save_figure(
             plot_reconstructions(ds.subset("test"), pred, settings),
             args.plot,

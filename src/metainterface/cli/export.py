@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from metainterface.io.export import FORMATS
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
@@ -19,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tiles", default="1x1", help="cells along x and y, e.g. 4x4 (default 1x1)")
     p.add_argument(
         "--format",
-        choices=["stl", "png", "tiff", "npy"],
+        choices=FORMATS,
         help="output format (default: from the --out suffix)",
     )
     p.add_argument("--out", required=True, help="output file; a sidecar OUT.json is written too")
@@ -35,36 +37,28 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import math
+    import metainterface as mi
+    from metainterface.physical import parse_length
 
-    from metainterface.errors import MetainterfaceError
-    from metainterface.io import load_design
-    from metainterface.io.export import export_design, parse_tiles
-    from metainterface.io.units import parse_length
-
-    radius = parse_length(args.radius, option="--radius")
-    base = parse_length(args.base, option="--base")
-    tiles = parse_tiles(args.tiles)
     resolution = None
     if args.resolution is not None:
         try:
             resolution = float(args.resolution)
         except ValueError:
-            resolution = math.nan
-        if not (math.isfinite(resolution) and resolution > 0):
-            raise MetainterfaceError(
+            resolution = float("nan")
+        if not (resolution > 0 and resolution < float("inf")):
+            raise mi.MetainterfaceError(
                 f"--resolution expects grid points per mm > 0, got {args.resolution!r}"
             )
-    design = load_design(args.design)
-    rec = export_design(
-        design,
+    # lengths parsed here so that errors name the options as typed
+    rec = mi.export(
+        args.design,
         args.out,
-        radius=radius,
-        tiles=tiles,
-        fmt=args.format,
+        radius=parse_length(args.radius, option="--radius"),
+        tiles=args.tiles,
+        format=args.format,
         resolution=resolution,
-        base=base,
-        source=args.design,
+        base=parse_length(args.base, option="--base"),
     )
     nx, ny = rec["tiles"]
     size = f"{rec['size_m'][0] * 1e3:.4g} x {rec['size_m'][1] * 1e3:.4g} mm"

@@ -106,12 +106,9 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if not (args.dataset and args.out):
         raise MetainterfaceError("train needs --dataset FILE and --out RUN_DIR (or --plot RUN_DIR)")
-    from metainterface.data import load_dataset
-    from metainterface.surrogate.data import split_of
-    from metainterface.surrogate.train import TrainConfig, train
+    import metainterface as mi
 
-    ds = load_dataset(args.dataset)
-    config = TrainConfig(
+    config = mi.TrainConfig(
         epochs=args.epochs,
         batch_size=args.batch_size,
         seed=args.seed,
@@ -124,15 +121,7 @@ def run(args: argparse.Namespace) -> int:
         w_mag=args.w_mag,
         w_curve=args.w_curve,
     )
-    result = train(
-        split_of(ds, "train"),
-        split_of(ds, "val"),
-        ds.settings,
-        args.out,
-        config,
-        resume=args.resume,
-        dataset_info={"path": str(args.dataset), "samples": len(ds), "seed": ds.seed},
-    )
+    result = mi.train_surrogate(args.dataset, args.out, config, resume=args.resume)
     print(
         f"{result.run_dir}: {result.epochs_run} epochs in {result.seconds:.0f} s, best "
         f"validation loss {result.best_val_loss:.4f} at epoch {result.best_epoch}"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from metainterface.cli.common import positive_float, positive_int
+from metainterface.physics.models import DEFAULT_MODEL, MODELS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -58,8 +59,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--physics",
-        choices=("independent", "interacting"),
-        default="independent",
+        choices=tuple(MODELS),
+        default=DEFAULT_MODEL,
         help="forward model that sets the loads and alpha_model: the paper's independent "
         "asperities (default) or with their elastic interaction; both are reported",
     )
@@ -68,79 +69,40 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm.auto import tqdm
+    import metainterface as mi
 
-    from metainterface.errors import MetainterfaceError
-    from metainterface.io import load_design, write_columns
-    from metainterface.validation import (
-        available_cpus,
-        model_curve,
-        plan_validation,
-        require_tamaas,
-        write_result,
-    )
-    from metainterface.validation.models import models_at
-
-    require_tamaas()
-    design = load_design(args.design)
-    loads: object = args.loads
-    if args.p_max is not None:
-        p_top = model_curve(design, args.physics).p_star_max
-        if args.p_max > p_top * (1 + 1e-12):
-            raise MetainterfaceError(
-                f"--p-max {args.p_max:g} is beyond what the design reaches at Delta_max "
-                f"(P*_max = {p_top:.6g}); allowed range (0, {p_top:.6g}]"
-            )
-        loads = [args.p_max * i / args.loads for i in range(1, args.loads + 1)]
-    plan = plan_validation(
-        design,
-        args.grid,
-        loads,
-        name=args.design,
+    result = mi.validate(
+        args.design,
+        grid=args.grid,
+        loads=args.loads,
+        p_max=args.p_max,
+        model=args.physics,
         tolerance=args.tolerance,
-        physics=args.physics,
-    )  # checks all input
-    jobs = args.jobs or min(available_cpus(), args.loads)
-    with tqdm(total=args.loads, desc="BEM loads", unit="load") as bar:
-        result = plan.solve(jobs, progress=bar.update)
-    write_result(result, args.out, command="validate", jobs=jobs)
-    both = models_at(design, result.p_star)
-    rel = {name: result.alpha_bem / alpha - 1.0 for name, alpha in both.items()}
-    columns = {"p_star": result.p_star, "alpha_bem": result.alpha_bem}
-    columns |= {f"alpha_{name}": alpha for name, alpha in both.items()}
-    columns |= {f"rel_err_{name}": r for name, r in rel.items()}
-    write_columns(
-        f"{args.out}/models.csv",
-        columns,
-        command="validate",
-        design=args.design,
-        grid=result.grid,
-        loads_from=args.physics,
+        jobs=args.jobs,
+        progress=True,
+        out=args.out,
     )
+    rel = {name: result.alpha_bem / a - 1.0 for name, a in result.alpha_by_model.items()}
     k = len(result.p_star)
     print(
         f"{args.out}: {k} loads on {result.grid}x{result.grid}, "
-        f"solves {result.seconds.sum():.1f} s (summed over {jobs} processes); "
-        f"max p/E* = {result.p_max.max():.4g}"
+        f"solves {result.seconds.sum():.1f} s; max p/E* = {result.p_max.max():.4g}"
     )
     print(
         f"largest relative error over the upper half of the loads "
         f"(P* >= {result.p_star[result.upper_half][0]:.4g}): "
-        f"{100 * result.max_rel_err_upper:.2f} % "
-        f"(counting grid points in contact: "
-        f"{100 * result.max_rel_err_upper_pixels:.2f} %)"
+        f"{100 * result.max_rel_err_upper:.3g} % "
+        f"(counting grid points in contact: {100 * result.max_rel_err_upper_pixels:.3g} %)"
     )
     upper = result.upper_half
     print(
-        "  by model (loads from the "
-        + args.physics
-        + " model): "
-        + ", ".join(f"{name} {100 * abs(r[upper]).max():.2f} %" for name, r in rel.items())
+        f"  by model (loads from the {result.model.label} model): "
+        + ", ".join(f"{name} {100 * abs(r[upper]).max():.3g} %" for name, r in rel.items())
     )
     errors = result.target_errors()
     if errors is not None:
         print(
-            f"error against the design's target at these loads: BEM {100 * errors[0]:.2f} %, "
-            f"{args.physics} model {100 * errors[1]:.2f} %"
+            f"error against the design's target at these loads: BEM {100 * errors[0]:.3g} %, "
+            f"{result.model.label} model {100 * errors[1]:.3g} %"
         )
     return 0

@@ -33,12 +33,12 @@ from typing import Any
 import numpy as np
 import torch
 
+from metainterface._files.atomic import atomic_open, ensure_parent
+from metainterface._files.provenance import provenance
 from metainterface.data.categories import CATEGORIES, CATEGORY_NAMES
 from metainterface.data.categories import category as find_category
 from metainterface.data.npz import NpzStreamWriter
 from metainterface.errors import MetainterfaceError
-from metainterface.io.atomic import atomic_open, ensure_parent
-from metainterface.io.provenance import provenance
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import curves_numpy
 

@@ -62,7 +62,7 @@ class NpzStreamWriter:
     specs: name -> (shape, dtype), in file order. ``write(name, rows)`` appends rows along
     axis 0 (for a 0-d array, pass the whole array once). ``close()`` checks that every array
     is complete and writes the archive's headers. Atomicity is the caller's business (open
-    ``fh`` with ``metainterface.io.atomic_open``).
+    ``fh`` with ``metainterface._files.atomic_open``).
     """
 
     def __init__(self, fh: IO[bytes], specs: Mapping[str, tuple[tuple[int, ...], Any]]) -> None:

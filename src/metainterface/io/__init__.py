@@ -1,28 +1,27 @@
-"""Files at the edge of the package: design files, CSV, atomic writes, provenance."""
+"""File formats for making the surface: STL meshes and height maps (PNG, TIFF, NPY).
 
-from metainterface.io.atomic import atomic_open, ensure_parent, write_bytes, write_text
-from metainterface.io.csvfiles import read_columns, write_columns
-from metainterface.io.design_file import (
-    FORMAT,
-    design_from_dict,
-    design_to_dict,
-    load_design,
-    save_design,
+Design files (design-v1 JSON) are read and written by :class:`~metainterface.Design` itself
+(``Design.load`` / ``Design.save``); CSV columns and atomic writes are ``metainterface._files``.
+"""
+
+from metainterface.io.export import (
+    FORMATS,
+    Patch,
+    export_design,
+    format_for,
+    height_patch,
+    parse_tiles,
+    patch_mesh,
+    sidecar_path,
 )
-from metainterface.io.provenance import csv_header, provenance
 
 __all__ = [
-    "FORMAT",
-    "atomic_open",
-    "csv_header",
-    "design_from_dict",
-    "design_to_dict",
-    "ensure_parent",
-    "load_design",
-    "provenance",
-    "read_columns",
-    "save_design",
-    "write_bytes",
-    "write_columns",
-    "write_text",
+    "FORMATS",
+    "Patch",
+    "export_design",
+    "format_for",
+    "height_patch",
+    "parse_tiles",
+    "patch_mesh",
+    "sidecar_path",
 ]

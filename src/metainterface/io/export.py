@@ -30,9 +30,9 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._files.atomic import write_bytes, write_text
+from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
-from metainterface.io.atomic import write_bytes, write_text
-from metainterface.io.provenance import provenance
 from metainterface.physics.cell import Design
 
 FORMATS = ("stl", "png", "tiff", "npy")

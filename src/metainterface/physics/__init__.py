@@ -15,6 +15,17 @@ from metainterface.physics.curves import (
     sweep,
     to_grid,
 )
+from metainterface.physics.models import (
+    DEFAULT_MODEL,
+    MODELS,
+    ForwardModel,
+    Independent,
+    Interacting,
+    ModelCurve,
+    get_model,
+    models_at,
+    register_model,
+)
 from metainterface.physics.sneddon import (
     area,
     contact_radius,
@@ -28,9 +39,15 @@ from metainterface.physics.sneddon import (
 )
 
 __all__ = [
+    "DEFAULT_MODEL",
+    "MODELS",
     "CellSettings",
     "Curve",
     "Design",
+    "ForwardModel",
+    "Independent",
+    "Interacting",
+    "ModelCurve",
     "Sweep",
     "alpha_at",
     "anchor",
@@ -43,11 +60,14 @@ __all__ = [
     "engagement",
     "features_from_normalised",
     "force",
+    "get_model",
     "indentation",
     "interp",
     "kappa",
     "log_kappa",
     "log_kc",
+    "models_at",
+    "register_model",
     "shape_constant",
     "sweep",
     "to_grid",

@@ -9,13 +9,18 @@ is L = 4 n a_max and A_nom = L^2. Lengths are in the unit of R (R = 1 in the cor
 from __future__ import annotations
 
 import functools
+import json
 import math
+import os
 from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import torch
 
+from metainterface._files.atomic import write_text
+from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.sneddon import contact_radius
 
@@ -172,6 +177,97 @@ class Design:
             torch.as_tensor(self.gamma, dtype=dtype)[None],
             torch.as_tensor(self.h, dtype=dtype)[None],
         )
+
+    def __repr__(self) -> str:
+        s = self.settings
+        opts = dict(precision=3, separator=", ", max_line_width=10**6, suppress_small=True)
+        g = np.array2string(self.gamma, **opts)
+        h = np.array2string(self.h / s.delta_max, **opts)
+        return (
+            f"Design(N={self.n_asperities}, gamma={g}, h/Delta_max={h}, "
+            f"gamma in [{s.gamma_min:g}, {s.gamma_max:g}], Delta_max={s.delta_max:g} R)"
+        )
+
+    # --- the design file format, metainterface/design-v1 ---------------------------------
+
+    def to_dict(self, **extra: Any) -> dict[str, Any]:
+        """The design-v1 mapping; ``extra`` keys are added (they override ``extras``)."""
+        s = self.settings
+        out: dict[str, Any] = {
+            "format": FORMAT,
+            "gamma": [float(g) for g in self.gamma],
+            "h": [float(v) for v in self.h],
+            "radius": s.radius,
+            "delta_max": s.delta_max,
+            "gamma_bounds": [s.gamma_min, s.gamma_max],
+            "e_star": s.e_star,
+        }
+        out.update(self.extras)
+        out.update(extra)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Any, *, source: str = "design") -> Design:
+        """Build and validate a Design from a parsed design-v1 mapping; errors name
+        ``source`` and the field."""
+        if not isinstance(data, dict):
+            raise MetainterfaceError(f"{source}: expected a JSON object with keys gamma and h")
+        fmt = data.get("format", FORMAT)
+        if fmt != FORMAT:
+            raise MetainterfaceError(f"{source}: unknown format {fmt!r}, expected {FORMAT!r}")
+        for key in ("gamma", "h"):
+            if key not in data:
+                raise MetainterfaceError(f"{source}: missing required field {key!r}")
+            if not isinstance(data[key], list):
+                raise MetainterfaceError(f"{source}: field {key!r} must be a list of numbers")
+        bounds = data.get("gamma_bounds", [1.8, 4.0])
+        if not (isinstance(bounds, list) and len(bounds) == 2):
+            raise MetainterfaceError(
+                f"{source}: gamma_bounds must be a list [gamma_min, gamma_max]"
+            )
+        try:
+            settings = CellSettings(
+                n_asperities=len(data["gamma"]),
+                radius=data.get("radius", 1.0),
+                e_star=data.get("e_star", 1.0),
+                delta_max=data.get("delta_max", 0.02),
+                gamma_min=bounds[0],
+                gamma_max=bounds[1],
+            )
+            extras = {k: v for k, v in data.items() if k not in _CORE_KEYS}
+            return cls(gamma=data["gamma"], h=data["h"], settings=settings, extras=extras)
+        except MetainterfaceError as exc:
+            raise MetainterfaceError(f"{source}: {exc}") from None
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Design:
+        """Read and validate a design file; errors name the file and the field."""
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise MetainterfaceError(f"{path}: file not found") from None
+        except (OSError, UnicodeDecodeError) as exc:
+            raise MetainterfaceError(f"{path}: cannot read ({exc})") from None
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise MetainterfaceError(
+                f"{path}: malformed JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
+            ) from None
+        return cls.from_dict(data, source=str(path))
+
+    def save(self, path: str | os.PathLike[str], **extra: Any) -> Path:
+        """Write the design file atomically (with a provenance record unless it carries
+        one); ``extra`` keys are stored beside the design. Returns the path."""
+        data = self.to_dict(**extra)
+        data.setdefault("provenance", provenance())
+        return write_text(path, json.dumps(data, indent=2) + "\n")
+
+
+#: The design file format every command reads and writes.
+FORMAT = "metainterface/design-v1"
+_CORE_KEYS = {"format", "gamma", "h", "radius", "delta_max", "gamma_bounds", "e_star"}
 
 
 def _as_vector(name: str, values: Any) -> np.ndarray:

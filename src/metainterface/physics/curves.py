@@ -19,7 +19,6 @@ from torch import Tensor
 
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.sneddon import dlog_kc, engagement, indentation, log_kc
-from metainterface.runtime import tune_allocator
 
 
 @dataclass(frozen=True)
@@ -489,7 +488,6 @@ def curves_numpy(
     gamma, h: (S, N). Returns float32 arrays p_star_max (S,), alpha_max (S,),
     alpha_hat (S, n), stiffness_hat (S, n).
     """
-    tune_allocator()
     s, n = gamma.shape[0], settings.n_steps
     out = {
         "p_star_max": np.empty(s, np.float32),

@@ -10,9 +10,9 @@ from typing import Any
 
 from matplotlib.figure import Figure
 
+from metainterface._files.atomic import write_bytes
+from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
-from metainterface.io.atomic import write_bytes
-from metainterface.io.provenance import provenance
 
 _FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
 

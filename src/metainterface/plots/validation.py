@@ -24,15 +24,15 @@ def plot_validation(
     fig = new_figure(width=13.0, height=4.0)
     ax_c, ax_h, ax_p = fig.subplots(1, 3)
     p_top = float(result.p_star[-1])
-    keep = result.model.p_star <= p_top * (1 + 1e-12)
+    keep = result.curve.p_star <= p_top * (1 + 1e-12)
     if target is not None:
         ax_c.plot(target[0], target[1], color="k", lw=1.5, label="target")
     ax_c.plot(
-        result.model.p_star[keep],
-        result.model.alpha[keep],
+        result.curve.p_star[keep],
+        result.curve.alpha[keep],
         ls="--",
         color="C0",
-        label=f"model ({result.physics})",
+        label=f"model ({result.model.label})",
     )
     ax_c.plot(
         result.p_star,

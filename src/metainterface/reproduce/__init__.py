@@ -22,9 +22,9 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._files.atomic import write_text
+from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
-from metainterface.io.atomic import write_text
-from metainterface.io.provenance import provenance
 from metainterface.reproduce.scales import PAPER, SCALES, Scale, get_scale
 
 __all__ = ["PAPER", "SCALES", "ReproduceResult", "Scale", "get_scale", "reproduce"]

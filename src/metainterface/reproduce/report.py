@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from metainterface.data import FIGURE_ORDER
-from metainterface.design import METHODS
+from metainterface.inverse import METHODS
 from metainterface.reproduce.scales import PAPER, Scale
 
 #: Largest excess of the surrogate's error over multistart's still called a match (fig. 5).

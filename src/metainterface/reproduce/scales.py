@@ -9,8 +9,8 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-from metainterface.design.refine import RefineSettings
 from metainterface.errors import MetainterfaceError
+from metainterface.inverse.refine import RefineSettings
 
 
 @dataclass(frozen=True)

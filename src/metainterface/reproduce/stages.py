@@ -17,11 +17,12 @@ import numpy as np
 import torch
 from matplotlib.figure import Figure
 
+from metainterface._files.atomic import write_text
+from metainterface.api.results import design_curve
 from metainterface.data import generate_dataset, load_dataset
 from metainterface.data.dataset import Dataset
-from metainterface.design import METHODS, builtin_target, design
 from metainterface.errors import MetainterfaceError
-from metainterface.io.atomic import write_text
+from metainterface.inverse import METHODS, builtin_target, design
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.curves import curve, sweep
 from metainterface.physics.sneddon import area, force, shape_constant
@@ -457,7 +458,12 @@ def stage_fig5(ctx: Context) -> dict[str, Any]:
                 hedge=0,  # the paper's pipeline: the zero-shot prediction is the only start
             )[0]
     ctx.data["designs"] = results
-    fig = plot_comparison([[results[t][m] for m in METHODS] for t in OOD_TARGETS])
+    per_target = [[results[t][m] for m in METHODS] for t in OOD_TARGETS]
+    curves = [
+        [design_curve(Design(r.gamma, r.h, settings), r.model, steps=512) for r in row]
+        for row in per_target
+    ]
+    fig = plot_comparison(per_target, curves)
     rows = {
         t: {
             m: {

@@ -13,8 +13,8 @@ from typing import Any
 
 import torch
 
+from metainterface._files.atomic import write_bytes
 from metainterface.errors import MetainterfaceError
-from metainterface.io.atomic import write_bytes
 from metainterface.physics.cell import CellSettings
 from metainterface.surrogate.model import InverseMLP
 

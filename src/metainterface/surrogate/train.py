@@ -27,13 +27,12 @@ import numpy as np
 import torch
 from tqdm.auto import tqdm
 
+from metainterface._files.atomic import write_text
+from metainterface._files.columns import write_columns
+from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
-from metainterface.io.atomic import write_text
-from metainterface.io.csvfiles import write_columns
-from metainterface.io.provenance import provenance
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import curve
-from metainterface.runtime import tune_allocator
 from metainterface.surrogate.checkpoint import load_torch, save_model, save_torch
 from metainterface.surrogate.data import Split
 from metainterface.surrogate.loss import PAPER_WEIGHTS, LossWeights, param_loss, physics_loss
@@ -162,7 +161,6 @@ def train(
 ) -> TrainResult:
     """Train (or resume) a surrogate in ``out_dir``; returns a summary of the run."""
     config = config or TrainConfig()
-    tune_allocator()
     _check_sizes(train_split, val_split, config.batch_size)
     out = Path(out_dir)
     ckpt_path = out / "checkpoint.pt"
@@ -291,6 +289,6 @@ def write_metrics(path: Path, history: list[dict[str, float]]) -> None:
 
 def read_metrics(run_dir: str | os.PathLike[str]) -> dict[str, np.ndarray]:
     """metrics.csv of a run folder as columns."""
-    from metainterface.io.csvfiles import read_columns
+    from metainterface._files.columns import read_columns
 
     return read_columns(Path(run_dir) / "metrics.csv", METRICS)

@@ -1,4 +1,4 @@
-"""Validation of the independent-asperity model against the boundary element method.
+"""Validation of the forward models against the boundary element method (Tamaas).
 
 Tamaas is imported only when a solve starts (``bem.require_tamaas``), so this package loads,
 and gives a clear message, without it.
@@ -21,51 +21,39 @@ from metainterface.validation.heightmap import (
     height_map,
     owner_map,
 )
-from metainterface.validation.models import (
-    MODELS,
-    ModelCurve,
-    independent_asperities,
-    model_curve,
-    register_model,
-)
 from metainterface.validation.validate import (
     DEFAULT_LOADS,
     ValidationPlan,
     ValidationResult,
+    check_jobs,
     design_target,
     plan_validation,
     resolve_loads,
     validate_design,
-    validate_many,
-    write_result,
+    validation_request,
 )
 
 __all__ = [
     "DEFAULT_LOADS",
     "MAX_ITER",
-    "MODELS",
     "TOLERANCE",
     "HeightMap",
     "LoadPath",
-    "ModelCurve",
     "ValidationPlan",
     "ValidationResult",
     "available_cpus",
     "cell_height_map",
     "check_grid",
+    "check_jobs",
     "default_grid",
     "design_target",
     "height_map",
-    "independent_asperities",
-    "model_curve",
     "owner_map",
     "plan_validation",
-    "register_model",
     "require_tamaas",
     "resolve_loads",
     "solve_loads",
     "solve_path",
     "validate_design",
-    "validate_many",
-    "write_result",
+    "validation_request",
 ]

@@ -7,8 +7,8 @@ import pytest
 
 import metainterface
 from metainterface.errors import MetainterfaceError
-from metainterface.io import load_design
-from metainterface.io.physical import physical_block
+from metainterface.physical.dimensions import physical_block
+from metainterface.physics import Design
 from metainterface.physics.curves import design_sweep
 
 EXAMPLE = Path(metainterface.__file__).parent / "examples" / "example_design.json"
@@ -16,7 +16,7 @@ R, E = 0.5e-3, 2e6
 
 
 def test_dimensions_follow_section_2_3():
-    design = load_design(EXAMPLE)
+    design = Design.load(EXAMPLE)
     s = design.settings
     p_star_max = float(design_sweep(design).p_star[0, -1])
     blk = physical_block(design, radius=R, e_star=E, total_force=50.0)
@@ -34,7 +34,7 @@ def test_dimensions_follow_section_2_3():
 
 
 def test_bad_physical_input():
-    design = load_design(EXAMPLE)
+    design = Design.load(EXAMPLE)
     with pytest.raises(MetainterfaceError, match="radius must be"):
         physical_block(design, radius=0.0, e_star=E)
     with pytest.raises(MetainterfaceError, match="not both"):

@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._files.columns import read_columns
 from metainterface.errors import MetainterfaceError
-from metainterface.io.csvfiles import read_columns
 from metainterface.physics.cell import CellSettings
 
 FORCE_COLUMNS = ("normal_force", "friction_force")
@@ -223,7 +223,7 @@ def friction_target(
     """Convert a friction law (a FrictionLaw or a CSV path) into the alpha(P*) target.
 
     shear_strength tau [Pa], e_star E* [Pa], radius R [m], area: nominal area of the whole
-    interface [m^2], all > 0 (parse them with ``metainterface.io.units``). settings: the cell
+    interface [m^2], all > 0 (parse them with ``metainterface.physical.units``). settings: the cell
     (default: the paper's), used for L. include_origin: prepend (0 N, 0 N) when the first load
     is > 0 (F_f = tau A_real vanishes with the load). Errors name the row.
     """
@@ -300,7 +300,7 @@ def friction_target_from_options(
 
     Errors name the options --friction-csv, --shear-strength, --modulus, --radius, --area.
     """
-    from metainterface.io.units import parse_area, parse_length, parse_pressure
+    from metainterface.physical.units import parse_area, parse_length, parse_pressure
 
     given = {
         "--shear-strength": shear_strength,

@@ -3,7 +3,7 @@
 import pytest
 import torch
 
-from metainterface.design.lbfgs import _History, minimize
+from metainterface.inverse.lbfgs import History, minimize
 
 
 def explicit_direction(g: torch.Tensor, window: list[tuple[torch.Tensor, torch.Tensor]]):
@@ -32,7 +32,7 @@ def test_compact_direction_equals_the_explicit_inverse_bfgs_update(scale):
     torch.manual_seed(0)
     b, d, m, pushes = 3, 5, 4, 17
     invalid = [set(), set(range(2, pushes, 3)), {3, 4, 5, 6, 7}]
-    hist = _History(torch.zeros(b, d, dtype=torch.float64), m)
+    hist = History(torch.zeros(b, d, dtype=torch.float64), m)
     pairs = []
     for k in range(pushes):
         s = scale * torch.randn(b, d, dtype=torch.float64)
@@ -56,7 +56,7 @@ def test_compact_direction_equals_the_explicit_inverse_bfgs_update(scale):
 
 def test_no_history_is_steepest_descent():
     g = torch.randn(2, 3, dtype=torch.float64)
-    torch.testing.assert_close(_History(g, 5).direction(g), -g)
+    torch.testing.assert_close(History(g, 5).direction(g), -g)
 
 
 def test_rows_stop_at_the_loss_floor():

@@ -7,8 +7,7 @@ import pytest
 
 import metainterface
 from metainterface.errors import MetainterfaceError
-from metainterface.io import load_design, write_columns
-from metainterface.io.friction import (
+from metainterface.physical.friction import (
     alpha_to_friction,
     friction_columns,
     friction_target,
@@ -16,6 +15,7 @@ from metainterface.io.friction import (
     friction_to_alpha,
     read_friction_csv,
 )
+from metainterface.physics import Design
 from metainterface.physics.curves import design_sweep
 
 TAU, E_STAR, RADIUS, AREA = 0.25e6, 2e6, 0.5e-3, 4e-4  # 0.25 MPa, 2 MPa, 0.5 mm, 4 cm^2
@@ -23,13 +23,16 @@ EXAMPLE = Path(metainterface.__file__).parent / "examples" / "example_design.jso
 
 
 def _model_curve():
-    sw = design_sweep(load_design(EXAMPLE), n_delta=40)
+    sw = design_sweep(Design.load(EXAMPLE), n_delta=40)
     return sw.p_star[0].numpy(), sw.alpha[0].numpy()
 
 
 def _write(path, **columns):
-    write_columns(path, columns, note="test")  # with the '#' provenance line
-    return path
+    names = list(columns)
+    rows = zip(*(columns[n] for n in names), strict=True)
+    body = "\n".join(",".join(f"{v:.17g}" for v in row) for row in rows)
+    path.write_text('# {"note": "test"}\n' + ",".join(names) + "\n" + body + "\n")
+    return path  # with a '#' comment line, as the package writes them
 
 
 def test_friction_csv_round_trips_to_the_alpha_target(tmp_path):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from metainterface.errors import MetainterfaceError
-from metainterface.io import load_design, save_design
+from metainterface.physics import Design
 
 
 def write(tmp_path, data, name="d.json"):
@@ -17,11 +17,11 @@ def write(tmp_path, data, name="d.json"):
 
 def test_round_trip_keeps_extras_and_defaults(tmp_path):
     src = write(tmp_path, {"gamma": [2.0] * 4, "h": [0, 0.001, 0.002, 0.003], "note": {"a": 1}})
-    d = load_design(src)
+    d = Design.load(src)
     assert d.settings.n_asperities == 4 and d.settings.delta_max == 0.02
     assert d.extras == {"note": {"a": 1}}
-    out = save_design(tmp_path / "out" / "d2.json", d)
-    again = load_design(out)
+    out = d.save(tmp_path / "out" / "d2.json")
+    again = Design.load(out)
     np.testing.assert_array_equal(again.h, d.h)
     data = json.loads(out.read_text())
     assert data["format"] == "metainterface/design-v1" and data["note"] == {"a": 1}
@@ -49,4 +49,4 @@ def test_round_trip_keeps_extras_and_defaults(tmp_path):
 )
 def test_bad_files(tmp_path, data, message):
     with pytest.raises(MetainterfaceError, match=message):
-        load_design(write(tmp_path, data))
+        Design.load(write(tmp_path, data))

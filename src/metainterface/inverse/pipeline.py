@@ -11,35 +11,35 @@ from __future__ import annotations
 import copy
 import os
 import time
+import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
 from torch import Tensor
 
-from metainterface.design.refine import (
-    DTYPE,
+from metainterface.errors import MetainterfaceError
+from metainterface.inverse.params import DTYPE, FULL, HERTZ, Parameterisation
+from metainterface.inverse.refine import (
     RefineSettings,
     TargetGrid,
-    from_design,
     polish,
     refine,
     relative_error,
-    to_design,
 )
-from metainterface.design.targets import Target, target_features
-from metainterface.errors import MetainterfaceError
+from metainterface.inverse.targets import Target, target_features
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import alpha_at
-from metainterface.physics.forward import DEFAULT_PHYSICS, check_physics
-from metainterface.runtime import tune_allocator
+from metainterface.physics.models import ForwardModel, get_model
 
 if TYPE_CHECKING:  # the surrogate (and its imports) load only when a design needs it
     from metainterface.surrogate.model import InverseMLP
 
-METHODS = ("surrogate", "multistart", "hertz")
+#: Design methods and the parameterisation each refines: the surrogate's prediction and the
+#: multistart in the full space, the Hertz-only baseline with gamma fixed at 2.
+METHODS: dict[str, Parameterisation] = {"surrogate": FULL, "multistart": FULL, "hertz": HERTZ}
 
 
 @dataclass(frozen=True)
@@ -54,24 +54,18 @@ class DesignResult:
     seconds: float
     initial_error: float
     settings: CellSettings
-    physics: str = DEFAULT_PHYSICS
+    model: ForwardModel = field(default_factory=get_model)
     start: int = 0  # which start won: 0 = the zero-shot prediction (surrogate) or first start
     fallback: bool = False  # the design came from the surrogate method's fallback multistart
+    notes: tuple[str, ...] = ()  # what the pipeline decided for the user (e.g. no surrogate)
 
 
-def _starts(
-    count: int, n_targets: int, settings: CellSettings, seed: int, hertz: bool
+def random_starts(
+    count: int, n_targets: int, settings: CellSettings, seed: int, param: Parameterisation
 ) -> tuple[Tensor, Tensor]:
     """``count`` random starts (gamma, h), each (n_targets * count, N), the same for every
-    target: a target's design does not depend on the others in the batch. Each start is
-    drawn whole (gamma then h), so the first k of K starts are the k starts."""
-    gen = torch.Generator().manual_seed(seed)
-    n = settings.n_asperities
-    u = torch.rand((count, 2 * n), generator=gen, dtype=DTYPE)
-    gamma = settings.gamma_min + (settings.gamma_max - settings.gamma_min) * u[:, :n]
-    if hertz:
-        gamma = torch.full_like(gamma, 2.0)
-    h = settings.delta_max * u[:, n:]
+    target: a target's design does not depend on the others in the batch."""
+    gamma, h = param.random(count, settings, torch.Generator().manual_seed(seed))
     return gamma.repeat(n_targets, 1), h.repeat(n_targets, 1)
 
 
@@ -80,7 +74,7 @@ def _starts(
 JITTER_GAMMA, JITTER_H = 0.1, 0.05
 
 
-def _hedge_starts(
+def hedge_starts(
     gamma0: Tensor, h0: Tensor, hedge: int, settings: CellSettings, seed: int
 ) -> tuple[Tensor, Tensor]:
     """(T, hedge, N) extra starts beside the zero-shot designs gamma0, h0 (T, N).
@@ -91,7 +85,7 @@ def _hedge_starts(
     the surrogate reads wrong (the linear law). Seeded; the same for every target."""
     t, n = gamma0.shape
     jittered = (hedge + 1) // 2
-    g_r, h_r = _starts(hedge - jittered, t, settings, seed, hertz=False)
+    g_r, h_r = random_starts(hedge - jittered, t, settings, seed, FULL)
     gen = torch.Generator().manual_seed(seed + 1)
     z = torch.randn((jittered, 2 * n), generator=gen, dtype=gamma0.dtype)
     span = settings.gamma_max - settings.gamma_min
@@ -138,7 +132,7 @@ def design(
     seed: int = 0,
     refine_settings: RefineSettings | None = None,
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
-    physics: str = DEFAULT_PHYSICS,
+    model: str | ForwardModel | None = None,
     hedge: int = 0,
     fallback: int = 0,
     fallback_error: float = 0.02,
@@ -146,7 +140,7 @@ def design(
     """Design one cell per target with ``method``; returns one result per target.
 
     ``hedge`` (surrogate method only): also refine that many starts beside the zero-shot
-    prediction (:func:`_hedge_starts`: jittered copies of it, which find better neighbouring
+    prediction (:func:`hedge_starts`: jittered copies of it, which find better neighbouring
     optima, and random starts, a guard for targets far from the training distribution such
     as exactly linear laws) and keep the best, at the cost of a larger batch. 0 is the
     paper's pipeline.
@@ -157,10 +151,15 @@ def design(
     refinement) and keeps the better design (``DesignResult.fallback`` says which). Targets
     the surrogate meets cost nothing extra. 0 (the default) is the paper's pipeline.
 
-    ``physics`` is the forward model the refinement optimises and the error is measured with
-    ("independent", the paper's, or "interacting"); the surrogate was trained on the former.
+    ``model`` is the forward model the refinement optimises and the error is measured with
+    (a name in ``physics.models.MODELS`` or a ForwardModel); the surrogate was trained on
+    the independent one.
+
+    ``settings`` is the cell (N, gamma bounds, Delta_max). The surrogate method uses the
+    shipped model where it was trained for that cell; for another cell it warns and runs
+    the multistart instead (``DesignResult.notes`` says so).
     """
-    tune_allocator()
+    model = get_model(model)
     common = dict(
         refine_designs=refine_designs,
         settings=settings,
@@ -169,9 +168,16 @@ def design(
         seed=seed,
         refine_settings=refine_settings,
         extra_loss=extra_loss,
-        physics=physics,
+        model=model,
     )
+    method, notes = _usable_method(method, settings, model_path)
+    if notes:
+        warnings.warn(notes[0], stacklevel=2)
+        common["starts"] = max(starts, fallback)
+        hedge = fallback = 0
     results = _design(targets, method, hedge=hedge, **common)
+    if notes:
+        results = [replace(r, notes=notes) for r in results]
     missed = [i for i, r in enumerate(results) if r.error > fallback_error]
     if method != "surrogate" or fallback <= 0 or not missed:
         return results
@@ -198,10 +204,9 @@ def _design(
     seed: int,
     refine_settings: RefineSettings | None,
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None,
-    physics: str,
+    model: ForwardModel,
     hedge: int,
 ) -> list[DesignResult]:
-    check_physics(physics)
     if method not in METHODS:
         raise MetainterfaceError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     if starts < 1:
@@ -213,38 +218,30 @@ def _design(
     if method == "surrogate":
         from metainterface.surrogate.checkpoint import default_model_path, load_model
 
-        model, model_settings, _ = load_model(model_path or default_model_path())
-        if (
-            settings is not None
-            and settings.with_(n_steps=model_settings.n_steps) != model_settings
-        ):
-            raise MetainterfaceError(
-                f"the surrogate was trained for another cell ({model_settings.to_dict()}); "
-                "use --method multistart for these settings or train a model for them"
-            )
+        net, model_settings, _ = load_model(model_path or default_model_path())
         settings = model_settings
-        gamma0, h0 = predict(model, targets, settings)
-        per_target, hertz = 1 + max(hedge, 0), False
+        gamma0, h0 = predict(net, targets, settings)
+        per_target = 1 + max(hedge, 0)
         if hedge > 0:  # rows per target: [zero-shot, hedge starts]
-            g_r, h_r = _hedge_starts(gamma0, h0, hedge, settings, seed)
+            g_r, h_r = hedge_starts(gamma0, h0, hedge, settings, seed)
             gamma0 = torch.cat([gamma0[:, None], g_r], 1).flatten(0, 1)
             h0 = torch.cat([h0[:, None], h_r], 1).flatten(0, 1)
     else:
         settings = settings or CellSettings()
-        hertz = method == "hertz"
         per_target = starts
-        gamma0, h0 = _starts(starts, len(targets), settings, seed, hertz)
+        gamma0, h0 = random_starts(starts, len(targets), settings, seed, METHODS[method])
     grid = TargetGrid.from_curves(
         [(t.p_star, t.alpha) for t in targets], refine_settings.grid_points
     )
     rows = grid.rows(torch.arange(len(targets)).repeat_interleave(per_target))
     # the error of the starts as given (the refinement starts a little inside the bounds)
-    err0 = relative_error(gamma0, h0, settings, rows, physics)
-    raw = from_design(gamma0, h0, settings, hertz)
+    param = METHODS[method]
+    err0 = relative_error(gamma0, h0, settings, rows, model)
+    raw = param.from_design(gamma0, h0, settings)
     if refine_designs:
-        raw = refine(raw, settings, rows, refine_settings, hertz, extra_loss, physics)
-    gamma, h = to_design(raw.detach(), settings, hertz)
-    err = relative_error(gamma, h, settings, rows, physics)
+        raw = refine(raw, settings, rows, refine_settings, param, extra_loss, model)
+    gamma, h = param.to_design(raw.detach(), settings)
+    err = relative_error(gamma, h, settings, rows, model)
     offset = torch.arange(len(targets))[:, None] * per_target
     if refine_designs and refine_settings.polish_iterations > 0:
         # The early stops cut the search short on every row; the best few of each target get
@@ -253,9 +250,9 @@ def _design(
         kept_rows = err.view(len(targets), per_target).topk(top, largest=False).indices + offset
         kept_rows = kept_rows.reshape(-1)
         kept = rows.rows(kept_rows)
-        raw_w = polish(raw[kept_rows], settings, kept, refine_settings, hertz, extra_loss, physics)
-        g_w, h_w = to_design(raw_w, settings, hertz)
-        err_w = relative_error(g_w, h_w, settings, kept, physics)
+        raw_w = polish(raw[kept_rows], settings, kept, refine_settings, param, extra_loss, model)
+        g_w, h_w = param.to_design(raw_w, settings)
+        err_w = relative_error(g_w, h_w, settings, kept, model)
         better = err_w < err[kept_rows]
         gamma[kept_rows] = torch.where(better[:, None], g_w, gamma[kept_rows])
         h[kept_rows] = torch.where(better[:, None], h_w, h[kept_rows])
@@ -276,11 +273,35 @@ def _design(
             seconds=seconds,
             initial_error=float(first[i]),
             settings=settings,
-            physics=physics,
+            model=model,
             start=int(winner[i]),
         )
         for i, (t, b) in enumerate(zip(targets, best.tolist(), strict=True))
     ]
+
+
+def _usable_method(
+    method: str,
+    settings: CellSettings | None,
+    model_path: str | os.PathLike[str] | None,
+) -> tuple[str, tuple[str, ...]]:
+    """The method to run: the surrogate only for the cell it was trained for, else the
+    multistart, with a note saying why."""
+    if method != "surrogate" or settings is None:
+        return method, ()
+    from metainterface.surrogate.checkpoint import default_model_path, load_model
+
+    path = model_path or default_model_path()
+    _, trained, _ = load_model(path)
+    if settings.with_(n_steps=trained.n_steps) == trained:
+        return method, ()
+    mine = {k: v for k, v in settings.to_dict().items() if trained.to_dict()[k] != v}
+    note = (
+        f"the surrogate ({path}) was trained for another cell (yours differs in "
+        f"{', '.join(f'{k}={v:g}' for k, v in mine.items())}); designing by multistart instead "
+        "(train a surrogate for this cell to use one)"
+    )
+    return "multistart", (note,)
 
 
 def reachable_envelope(
@@ -296,7 +317,7 @@ def reachable_envelope(
     uniform = gammas[:, None].expand(-1, n)
     single_h = torch.full((12, n), 3 * settings.delta_max, dtype=DTYPE)
     single_h[:, 0] = 0.0
-    g_r, h_r = _starts(samples, 1, settings, seed, hertz=False)
+    g_r, h_r = random_starts(samples, 1, settings, seed, FULL)
     gamma = torch.cat([uniform, uniform, g_r])
     h = torch.cat([torch.zeros(12, n, dtype=DTYPE), single_h, h_r])
     p = torch.as_tensor(p_star, dtype=DTYPE)[None].expand(gamma.shape[0], -1)

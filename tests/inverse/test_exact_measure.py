@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import torch
 
-from metainterface.design import TargetGrid, builtin_target, relative_error
+from metainterface.inverse import TargetGrid, builtin_target, relative_error
 from metainterface.physics import CellSettings
-from metainterface.physics.forward import alpha_at
+from metainterface.physics.models import get_model
 
 S = CellSettings()
 
@@ -34,16 +34,16 @@ def test_single_hertz_asperity_at_given_pressures_matches_the_closed_form(physic
     a_nom = s.nominal_area
     p_max = 4.0 / 3.0 * s.delta_max**1.5 / a_nom  # Hertz at Delta_max: a = sqrt(R Delta)
     p = torch.linspace(0.0, 0.999, 50, dtype=torch.float64)[None] * p_max
-    alpha, _ = alpha_at(g, h, s, p, exact=True, physics=physics)
+    alpha, _ = get_model(physics).alpha_at(g, h, s, p, exact=True)
     closed = math.pi * (3.0 * p * a_nom / 4.0) ** (2.0 / 3.0) / a_nom
     if physics == "independent":
         np.testing.assert_allclose(alpha, closed, rtol=1e-10, atol=1e-15)
-        interpolated, _ = alpha_at(g, h, s, p)
+        interpolated, _ = get_model().alpha_at(g, h, s, p)
         assert float((interpolated - closed).abs().max()) > 1e3 * float(
             (alpha - closed).abs().max()
         )
     else:  # a few % off Hertz at most, and still the model's own interpolated curve
-        fine, _ = alpha_at(g, h, s, p, physics=physics, n_delta=20001)
+        fine, _ = get_model(physics).alpha_at(g, h, s, p, n_delta=20001)
         np.testing.assert_allclose(alpha, fine, rtol=1e-6, atol=1e-12)
 
 
@@ -51,20 +51,20 @@ def _random_designs(b: int) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     gen = torch.Generator().manual_seed(3)
     g = 1.8 + 2.2 * torch.rand((b, 9), generator=gen, dtype=torch.float64)
     h = S.delta_max * torch.rand((b, 9), generator=gen, dtype=torch.float64)
-    p_max = alpha_at(g, h, S, torch.zeros((b, 1), dtype=torch.float64))[1]
+    p_max = get_model().alpha_at(g, h, S, torch.zeros((b, 1), dtype=torch.float64))[1]
     p = torch.linspace(0.0, 1.1, 40, dtype=torch.float64)[None] * p_max[:, None]
     return g, h, p
 
 
 def test_exact_alpha_is_the_limit_of_finer_sweeps_and_is_held_beyond_p_max():
     g, h, p = _random_designs(4)
-    exact, p_max = alpha_at(g, h, S, p, exact=True)
-    fine, _ = alpha_at(g, h, S, p, n_delta=40001)
-    coarse, _ = alpha_at(g, h, S, p)
+    exact, p_max = get_model().alpha_at(g, h, S, p, exact=True)
+    fine, _ = get_model().alpha_at(g, h, S, p, n_delta=40001)
+    coarse, _ = get_model().alpha_at(g, h, S, p)
     assert float((fine - exact).abs().max()) < 1e-4 * float((coarse - exact).abs().max())
     beyond = p >= p_max[:, None]
     assert bool(beyond.any())
-    last = alpha_at(g, h, S, p_max[:, None], exact=True)[0]
+    last = get_model().alpha_at(g, h, S, p_max[:, None], exact=True)[0]
     torch.testing.assert_close(exact, torch.where(beyond, last, exact))
 
 
@@ -75,7 +75,7 @@ def test_exact_alpha_gradient_matches_finite_differences():
     g.requires_grad_(True)
     h.requires_grad_(True)
     assert torch.autograd.gradcheck(
-        lambda gg, hh: alpha_at(gg, hh, S, p, exact=True)[0],
+        lambda gg, hh: get_model().alpha_at(gg, hh, S, p, exact=True)[0],
         (g, h),
         eps=1e-7,
         atol=1e-6,
@@ -86,4 +86,4 @@ def test_exact_alpha_gradient_matches_finite_differences():
 def test_exact_alpha_rejects_the_softplus():
     g, h, p = _random_designs(1)
     with pytest.raises(ValueError, match="exact contact law"):
-        alpha_at(g, h, S, p, exact=True, smooth=1e4)
+        get_model().alpha_at(g, h, S, p, exact=True, smooth=1e4)

@@ -61,7 +61,7 @@ def _rows_value_and_grad(
     return f, g
 
 
-class _History:
+class History:
     """The last ``m`` curvature pairs of every row, stacked for the compact form.
 
     The pairs live in a buffer (B, 2, L, D), s then y, with L = 2m slots: the window is the
@@ -201,7 +201,7 @@ def minimize(
     g = torch.where(torch.isinf(f)[:, None], 0.0, g)  # no gradient where there is no loss
     evals = 1
     active = (torch.linalg.vector_norm(g, torch.inf, -1) > tol_grad) & (f > tol_loss)
-    hist = _History(x, history)
+    hist = History(x, history)
     recent = [f]  # losses of the last stall_window iterations
     # 0-d constants: an operation with a Python number wraps it in a tensor every time
     minus_c2, zero, one = (x.new_tensor(c) for c in (-C2, 0.0, 1.0))

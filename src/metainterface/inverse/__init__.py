@@ -1,6 +1,7 @@
-"""Inverse design: targets, the batched multi-stage L-BFGS refinement, the pipeline."""
+"""Inverse design: targets, parameterisations, the batched multi-stage refinement, the pipeline."""
 
-from metainterface.design.pipeline import (
+from metainterface.inverse.params import FULL, HERTZ, Parameterisation
+from metainterface.inverse.pipeline import (
     METHODS,
     DesignResult,
     design,
@@ -8,8 +9,8 @@ from metainterface.design.pipeline import (
     reachability_warnings,
     reachable_envelope,
 )
-from metainterface.design.refine import RefineSettings, TargetGrid, relative_error
-from metainterface.design.targets import (
+from metainterface.inverse.refine import RefineSettings, TargetGrid, relative_error
+from metainterface.inverse.targets import (
     BUILTIN_TARGETS,
     Target,
     builtin_target,
@@ -19,8 +20,11 @@ from metainterface.design.targets import (
 
 __all__ = [
     "BUILTIN_TARGETS",
+    "FULL",
+    "HERTZ",
     "METHODS",
     "DesignResult",
+    "Parameterisation",
     "RefineSettings",
     "Target",
     "TargetGrid",

@@ -21,15 +21,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 import torch
 from torch import Tensor
-from torch.nn import functional as nnf
 
-from metainterface.design import lbfgs, levmar
 from metainterface.errors import MetainterfaceError
+from metainterface.inverse import lbfgs, levmar
+from metainterface.inverse.params import DTYPE, FULL, Parameterisation
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import at_delta, interp_weights, relative_l2, solve_delta
-from metainterface.physics.forward import DEFAULT_PHYSICS, alpha_at, alpha_sweep_for, sweep_for
+from metainterface.physics.models import ForwardModel, get_model
 
-DTYPE = torch.float64
 POLISH_METHODS = ("levmar", "lbfgs")
 
 
@@ -135,55 +134,6 @@ class TargetGrid:
         return TargetGrid(self.p[index], self.alpha[index])
 
 
-def to_design(
-    raw: Tensor, settings: CellSettings, hertz: bool = False, *, sort: bool = True
-) -> tuple[Tensor, Tensor]:
-    """Unbounded parameters (B, 2N - 1), or (B, N - 1) if ``hertz``, -> (gamma, h), sorted
-    by height with each gamma kept with its h. The losses skip the sort (``sort=False``)
-    where the model is a sum over independent asperities, whose order changes nothing; the
-    interacting model places asperity k in lattice cell k, so there order matters."""
-    n = settings.n_asperities
-    if hertz:
-        r_h = raw
-        gamma = torch.full((raw.shape[0], n), 2.0, dtype=raw.dtype)
-    else:
-        r_g, r_h = raw[:, :n], raw[:, n:]
-        gamma = settings.gamma_min + (settings.gamma_max - settings.gamma_min) * torch.sigmoid(r_g)
-    h = torch.cat([torch.zeros_like(r_h[:, :1]), settings.delta_max * nnf.softplus(r_h)], dim=-1)
-    if not sort:
-        return gamma, h
-    h, order = torch.sort(h, dim=-1)
-    return gamma.gather(-1, order), h
-
-
-def _placed(physics: str) -> bool:
-    """Whether the model's response depends on which lattice cell each asperity is in."""
-    return physics != "independent"
-
-
-#: How far inside the bounds :func:`from_design` puts a start: gamma at least this fraction
-#: of its range from either bound, height gaps at least this fraction of Delta_max. Closer,
-#: the sigmoid and softplus flatten (slopes ~margin) and a start on a bound cannot move: the
-#: surrogate's design for the linear law (gammas at both bounds, gaps of 0) stayed at 108 %
-#: with 1e-4 and 1e-6.
-START_MARGIN = 0.01
-
-
-def from_design(gamma: Tensor, h: Tensor, settings: CellSettings, hertz: bool = False) -> Tensor:
-    """Inverse of :func:`to_design` for (B, N) designs (moved ``START_MARGIN`` inside the
-    bounds)."""
-    order = torch.argsort(h, dim=-1)
-    gamma, h = gamma.gather(-1, order), h.gather(-1, order)
-    h = (h - h[:, :1])[:, 1:] / settings.delta_max
-    r_h = torch.log(torch.expm1(h.clamp_min(START_MARGIN)))
-    if hertz:
-        return r_h.to(DTYPE)
-    u = ((gamma - settings.gamma_min) / (settings.gamma_max - settings.gamma_min)).clamp(
-        START_MARGIN, 1 - START_MARGIN
-    )
-    return torch.cat([torch.logit(u), r_h], dim=-1).to(DTYPE)
-
-
 def masked_loss(
     gamma: Tensor,
     h: Tensor,
@@ -191,17 +141,18 @@ def masked_loss(
     target: TargetGrid,
     smooth: float | None,
     undershoot: float = 0.1,
-    physics: str = DEFAULT_PHYSICS,
+    model: ForwardModel | None = None,
 ) -> Tensor:
     """The weighted MSE of appendix C per row (B,), relative to mean(alpha_t^2).
 
     With the softplus (the stages) alpha is interpolated in the paper's 128-sample sweep;
     on the exact law (the polish) it is exact at the target's pressures, as in
     :func:`relative_error`."""
+    model = get_model(model)
     if smooth is not None:
-        sw = alpha_sweep_for(physics)(gamma, h, settings, smooth=smooth)
-        return _InterpolatedLoss.apply(sw.p_star, sw.alpha, target.p, target.alpha, undershoot)
-    alpha, p_max = alpha_at(gamma, h, settings, target.p, physics=physics, exact=True)
+        sw = model.load_area(gamma, h, settings, smooth=smooth)
+        return InterpolatedLoss.apply(sw.p_star, sw.alpha, target.p, target.alpha, undershoot)
+    alpha, p_max = model.alpha_at(gamma, h, settings, target.p, exact=True)
     return (point_weights(p_max, target, undershoot) * (alpha - target.alpha) ** 2).sum(-1)
 
 
@@ -212,7 +163,7 @@ def point_weights(p_max: Tensor, target: TargetGrid, undershoot: float = 0.1) ->
     return w / (w.sum(-1, keepdim=True) * (target.alpha**2).mean(-1, keepdim=True))
 
 
-class _InterpolatedLoss(torch.autograd.Function):
+class InterpolatedLoss(torch.autograd.Function):
     """(P*, alpha) of a sweep (B, K) -> :func:`masked_loss` (B,), alpha interpolated at the
     target's pressures in the sweep with a (0, 0) knot first, held beyond its end.
 
@@ -257,8 +208,8 @@ def residuals(
     settings: CellSettings,
     target: TargetGrid,
     undershoot: float = 0.1,
-    physics: str = DEFAULT_PHYSICS,
-    hertz: bool = False,
+    model: ForwardModel | None = None,
+    param: Parameterisation = FULL,
 ) -> tuple[Tensor, Tensor]:
     """The exact-law loss as residuals r (B, M), ||r||^2 = :func:`masked_loss`, and their
     Jacobian in the unbounded parameters, dr/draw (B, M, D).
@@ -269,13 +220,14 @@ def residuals(
     cost of one gradient evaluation, not M.
     """
     b, m = target.p.shape
-    fn = sweep_for(physics)
+    model = get_model(model)
+    fn = model.sweep
     with torch.no_grad():
-        gamma, h = to_design(raw, settings, hertz, sort=_placed(physics))
+        gamma, h = param.to_design(raw, settings, sort=model.placed)
         delta, p_max = solve_delta(gamma, h, settings, target.p, sweep_fn=fn)
         weight = point_weights(p_max, target, undershoot).sqrt()  # (B, M)
     rep = raw.detach().repeat_interleave(m, 0).requires_grad_(True)
-    g_rep, h_rep = to_design(rep, settings, hertz, sort=_placed(physics))
+    g_rep, h_rep = param.to_design(rep, settings, sort=model.placed)
     alpha = at_delta(
         g_rep,
         h_rep,
@@ -295,13 +247,13 @@ def relative_error(
     h: Tensor,
     settings: CellSettings,
     target: TargetGrid,
-    physics: str = DEFAULT_PHYSICS,
+    model: ForwardModel | None = None,
 ) -> Tensor:
     """||alpha_design - alpha_target||_2 / ||alpha_target||_2 on the target's grid (exact
     law, alpha exact at the target's pressures, the design's curve held at its last value
     where it stops short). (B,)."""
     with torch.no_grad():
-        alpha, _ = alpha_at(gamma, h, settings, target.p, physics=physics, exact=True)
+        alpha, _ = get_model(model).alpha_at(gamma, h, settings, target.p, exact=True)
         return relative_l2(alpha, target.alpha)
 
 
@@ -310,9 +262,9 @@ def polish(
     settings: CellSettings,
     target: TargetGrid,
     rs: RefineSettings | None = None,
-    hertz: bool = False,
+    param: Parameterisation = FULL,
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
-    physics: str = DEFAULT_PHYSICS,
+    model: ForwardModel | None = None,
 ) -> Tensor:
     """The polish after the stages: Levenberg-Marquardt on the exact law if
     ``rs.polish_method`` says so and the loss is a sum of squares (no ``extra_loss``), then
@@ -320,10 +272,11 @@ def polish(
     else L-BFGS alone. Returns the polished raw parameters (B, D)."""
     rs = rs or RefineSettings()
     if rs.polish_method == "lbfgs" or extra_loss is not None or not rs.polish_exact:
-        return refine(raw, settings, target, rs.polishing(), hertz, extra_loss, physics)
+        return refine(raw, settings, target, rs.polishing(), param, extra_loss, model)
+    model = get_model(model)
 
     def fun(z: Tensor, idx: Tensor) -> tuple[Tensor, Tensor]:
-        return residuals(z, settings, target.rows(idx), rs.undershoot_weight, physics, hertz)
+        return residuals(z, settings, target.rows(idx), rs.undershoot_weight, model, param)
 
     res = levmar.least_squares(
         fun,
@@ -342,15 +295,15 @@ def polish(
     left = (res.loss > rs.tol_error**2).nonzero(as_tuple=True)[0]
     if left.shape[0]:
         rows = target.rows(left)
-        y = refine(raw[left], settings, rows, rs.polishing(), hertz, None, physics)
+        y = refine(raw[left], settings, rows, rs.polishing(), param, None, model)
         with torch.no_grad():
             loss = masked_loss(
-                *to_design(y, settings, hertz, sort=_placed(physics)),
+                *param.to_design(y, settings, sort=model.placed),
                 settings,
                 rows,
                 None,
                 rs.undershoot_weight,
-                physics,
+                model,
             )
         better = loss < res.loss[left]
         x[left] = torch.where(better[:, None], y, x[left])
@@ -362,21 +315,22 @@ def refine(
     settings: CellSettings,
     target: TargetGrid,
     rs: RefineSettings | None = None,
-    hertz: bool = False,
+    param: Parameterisation = FULL,
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
-    physics: str = DEFAULT_PHYSICS,
+    model: ForwardModel | None = None,
 ) -> Tensor:
     """Run the stages on a batch of unbounded parameters (B, D); each row is its own problem
     against the matching row of ``target``. ``extra_loss(gamma, h, settings) -> (B,)`` is
     added if given (e.g. a pressure limit). Returns the refined raw parameters."""
     rs = rs or RefineSettings()
+    model = get_model(model)
     x = raw.detach().to(DTYPE)
     for kappa in rs.kappas():
 
         def fun(z: Tensor, idx: Tensor, kappa: float | None = kappa) -> Tensor:
-            gamma, h = to_design(z, settings, hertz, sort=_placed(physics))
+            gamma, h = param.to_design(z, settings, sort=model.placed)
             loss = masked_loss(
-                gamma, h, settings, target.rows(idx), kappa, rs.undershoot_weight, physics
+                gamma, h, settings, target.rows(idx), kappa, rs.undershoot_weight, model
             )
             return loss if extra_loss is None else loss + extra_loss(gamma, h, settings)
 

@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._files.atomic import write_text
+from metainterface._files.provenance import csv_header
 from metainterface.errors import MetainterfaceError
-from metainterface.io.atomic import write_text
-from metainterface.io.provenance import csv_header
 
 
 def write_columns(

@@ -80,3 +80,27 @@ def test_missing_tamaas_says_how_to_install(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "tamaas", None)  # import tamaas -> ImportError
     assert main(["validate", EXAMPLE, "--out", str(tmp_path / "run")]) == 2
     assert "pip install tamaas" in one_line_error(capsys)
+
+
+def test_validate_physics_reports_both(tmp_path, capsys):
+    out = tmp_path / "run"
+    args = ["validate", EXAMPLE, "--grid", "96", "--loads", "2", "--jobs", "1"]
+    assert main([*args, "--physics", "interacting", "--out", str(out)]) == 0
+    bem = np.genfromtxt(out / "bem.csv", delimiter=",", names=True, skip_header=1)
+    both = np.genfromtxt(out / "models.csv", delimiter=",", names=True, skip_header=1)
+    assert both.dtype.names == (
+        "p_star",
+        "alpha_bem",
+        "alpha_independent",
+        "alpha_interacting",
+        "rel_err_independent",
+        "rel_err_interacting",
+    )
+    np.testing.assert_allclose(both["p_star"], bem["p_star"])
+    np.testing.assert_allclose(both["alpha_interacting"], bem["alpha_model"], rtol=1e-4)
+    np.testing.assert_allclose(
+        both["rel_err_independent"], both["alpha_bem"] / both["alpha_independent"] - 1
+    )
+    printed = capsys.readouterr().out
+    assert "by model (loads from the interacting model): independent" in printed
+    assert '"loads_from": "interacting"' in (out / "models.csv").read_text().splitlines()[0]

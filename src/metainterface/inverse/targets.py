@@ -26,30 +26,126 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from metainterface._files.columns import read_columns
 from metainterface.errors import MetainterfaceError
-from metainterface.io.csvfiles import read_columns
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import at_pressures, sweep
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Target:
-    """A target curve: name, P* (M,) strictly increasing from ~0, alpha (M,) >= 0.
+    """A target contact law alpha(P*): what a design should reproduce.
 
-    stiffness: optional (M,) S* = dP*/dalpha at the same points (exact for built-ins).
-    source: where it came from (a built-in's definition or a file path).
+    p_star: (M,) dimensionless pressures P* = P / E*, strictly increasing from 0 (or near it).
+    alpha: (M,) contact-area fractions A_real / A_nom in [0, 1), ending > 0.
+    name: a label (used for output folders). stiffness: optional (M,) S* = dP*/dalpha at the
+    same points (exact for built-ins). source: where it came from. meta: anything else
+    recorded with the designs (e.g. the friction law it was made from).
+
+    Build one from arrays or lists (``Target(p_star=[...], alpha=[...], name="mine")``), or
+    with :meth:`builtin`, :meth:`from_csv` or :meth:`from_friction`. Checked on
+    construction: bad input raises MetainterfaceError naming the row and the rule.
     """
 
-    name: str
     p_star: np.ndarray
     alpha: np.ndarray
+    name: str = "target"
     stiffness: np.ndarray | None = None
     source: str = ""
     meta: dict = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise MetainterfaceError(f"target name must be a non-empty string, got {self.name!r}")
+        where = f"target {self.name}"
+        p = _column(where, "p_star", self.p_star)
+        a = _column(where, "alpha", self.alpha)
+        if p.shape != a.shape:
+            raise MetainterfaceError(
+                f"{where}: p_star and alpha must have the same length, got {p.size} and {a.size}"
+            )
+        check_target(self.name, p, a, self.source or where)
+        object.__setattr__(self, "p_star", p)
+        object.__setattr__(self, "alpha", a)
+        if self.stiffness is not None:
+            s = _column(where, "stiffness", self.stiffness)
+            if s.shape != p.shape:
+                raise MetainterfaceError(f"{where}: stiffness must have one value per point")
+            object.__setattr__(self, "stiffness", s)
+
     @property
     def p_star_max(self) -> float:
+        """The largest pressure of the target."""
         return float(self.p_star[-1])
+
+    def __repr__(self) -> str:
+        return (
+            f"Target({self.name!r}, {self.p_star.size} points, P* in [0, {self.p_star_max:.4g}], "
+            f"alpha in [{self.alpha.min():.4g}, {self.alpha.max():.4g}])"
+        )
+
+    @staticmethod
+    def builtins() -> tuple[str, ...]:
+        """The names of the built-in targets."""
+        return tuple(BUILTIN_TARGETS)
+
+    @classmethod
+    def builtin(cls, name: str) -> Target:
+        """A built-in target: ``saturating``, ``bilinear`` or ``linear`` (paper sec. 4)."""
+        return builtin_target(name)
+
+    @classmethod
+    def from_csv(cls, path: str | os.PathLike[str], name: str | None = None) -> Target:
+        """A target from a CSV with header ``p_star,alpha`` ('#' lines are skipped)."""
+        return target_from_csv(path, name)
+
+    @classmethod
+    def from_friction(
+        cls,
+        law: str | os.PathLike[str],
+        *,
+        shear_strength: str | float,
+        modulus: str | float,
+        radius: str | float,
+        area: str | float,
+        settings: CellSettings | None = None,
+        name: str | None = None,
+    ) -> Target:
+        """A target from a friction law: a CSV ``normal_force,friction_force`` [N] (or
+        ``normal_force,friction_coefficient``), one row per load.
+
+        shear_strength tau, modulus E*, radius R, area (nominal area of the whole interface):
+        quantities with units ('0.25MPa', '0.5mm', '4cm2') or numbers in SI. Bowden-Tabor:
+        alpha = F_f / (tau A), P* = F_n / (A E*). The conversion is kept in ``meta``.
+        """
+        from metainterface.physical.friction import friction_target
+        from metainterface.physical.units import parse_area, parse_length, parse_pressure
+
+        ft = friction_target(
+            law,
+            shear_strength=parse_pressure(shear_strength, option="shear_strength"),
+            e_star=parse_pressure(modulus, option="modulus"),
+            radius=parse_length(radius, option="radius"),
+            area=parse_area(area, option="area"),
+            settings=settings,
+        )
+        return cls(
+            p_star=ft.p_star,
+            alpha=ft.alpha,
+            name=name or Path(law).stem,
+            source=str(law),
+            meta={"friction": ft.record()},
+        )
+
+
+def _column(where: str, name: str, values: object) -> np.ndarray:
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise MetainterfaceError(f"{where}: {name} must be a list of numbers") from None
+    if arr.ndim != 1:
+        raise MetainterfaceError(f"{where}: {name} must be 1-D, got shape {arr.shape}")
+    return arr
 
 
 #: Pressures at which design targets are sampled: 127 * 8 + 1 uniform points, so that the
@@ -83,18 +179,18 @@ def design_targets(
         sw, _ = at_pressures(gamma, h, s, p)
     return [
         Target(
-            name,
-            p[i].numpy(),
-            sw.alpha[i].numpy(),
-            sw.stiffness[i].numpy(),
-            source,
-            {"gamma": gamma[i].tolist(), "h": h[i].tolist()},
+            p_star=p[i].numpy(),
+            alpha=sw.alpha[i].numpy(),
+            name=name,
+            stiffness=sw.stiffness[i].numpy(),
+            source=source,
+            meta={"gamma": gamma[i].tolist(), "h": h[i].tolist()},
         )
         for i, name in enumerate(names)
     ]
 
 
-def _design_target(name: str, gamma: list[float], h_frac: list[float], source: str) -> Target:
+def design_target_of(name: str, gamma: list[float], h_frac: list[float], source: str) -> Target:
     s = CellSettings()
     g = torch.tensor([gamma], dtype=torch.float64)
     h = torch.tensor([h_frac], dtype=torch.float64) * s.delta_max
@@ -102,7 +198,7 @@ def _design_target(name: str, gamma: list[float], h_frac: list[float], source: s
 
 
 def _saturating() -> Target:
-    return _design_target(
+    return design_target_of(
         "saturating",
         [3.2] * 9,
         [0.0125 * k for k in range(9)],
@@ -111,7 +207,7 @@ def _saturating() -> Target:
 
 
 def _bilinear() -> Target:
-    return _design_target(
+    return design_target_of(
         "bilinear",
         [2.0] * 4 + [3.6] * 5,
         [0.0] * 4 + [0.45] * 5,
@@ -121,7 +217,13 @@ def _bilinear() -> Target:
 
 def _linear() -> Target:
     p = np.linspace(0.0, 0.002, 128)
-    return Target("linear", p, 25.0 * p, np.full_like(p, 1 / 25.0), "alpha = 25 P*, P* <= 0.002")
+    return Target(
+        p_star=p,
+        alpha=25.0 * p,
+        name="linear",
+        stiffness=np.full_like(p, 1 / 25.0),
+        source="alpha = 25 P*, P* <= 0.002",
+    )
 
 
 BUILTIN_TARGETS: dict[str, Callable[[], Target]] = {
@@ -167,14 +269,20 @@ def check_target(name: str, p_star: np.ndarray, alpha: np.ndarray, where: str) -
         )
     if alpha[-1] <= 0:
         raise MetainterfaceError(f"{where}: alpha must become positive")
+    bad = np.flatnonzero(alpha >= 1)
+    if bad.size:
+        raise MetainterfaceError(
+            f"{where}: row {bad[0] + 1}: alpha = {alpha[bad[0]]:g} is not < 1 (a real contact "
+            "area cannot reach the nominal area)"
+        )
 
 
 def target_from_csv(path: str | os.PathLike[str], name: str | None = None) -> Target:
     """A target from a CSV with header ``p_star,alpha`` (>= 3 rows, p_star increasing from ~0)."""
     cols = read_columns(path, ("p_star", "alpha"))
-    p, a = cols["p_star"], cols["alpha"]
-    check_target(name or Path(path).stem, p, a, str(path))
-    return Target(name or Path(path).stem, p, a, None, str(path))
+    return Target(
+        p_star=cols["p_star"], alpha=cols["alpha"], name=name or Path(path).stem, source=str(path)
+    )
 
 
 def target_grid(target: Target, n: int = 128) -> tuple[np.ndarray, np.ndarray]:

@@ -2,8 +2,9 @@
 
 import torch
 
-from metainterface.design import builtin_target
-from metainterface.design.refine import TargetGrid, _InterpolatedLoss, masked_loss, to_design
+from metainterface.inverse import builtin_target
+from metainterface.inverse.params import FULL
+from metainterface.inverse.refine import InterpolatedLoss, TargetGrid, masked_loss
 from metainterface.physics import CellSettings
 from metainterface.physics.curves import alpha_at
 
@@ -20,7 +21,7 @@ def test_interpolated_loss_gradcheck():
     target = torch.rand(2, 40, generator=gen, dtype=F64)
 
     def loss(p_, a_):
-        return _InterpolatedLoss.apply(p_, a_, q, target, 0.1)
+        return InterpolatedLoss.apply(p_, a_, q, target, 0.1)
 
     assert torch.autograd.gradcheck(loss, (p.requires_grad_(), alpha.requires_grad_()))
 
@@ -34,7 +35,7 @@ def test_stage_loss_equals_the_masked_mse_of_the_interpolated_curve():
     grid = TargetGrid.from_curves([(t.p_star, t.alpha) for t in targets], 64)
     gen = torch.Generator().manual_seed(1)
     raw = (torch.randn(3, 17, generator=gen, dtype=F64) - 1.0).requires_grad_(True)
-    g, h = to_design(raw, s)
+    g, h = FULL.to_design(raw, s)
     fused = masked_loss(g, h, s, grid, 1e3)
     (grad,) = torch.autograd.grad(fused.sum(), raw, retain_graph=True)
     a, p_max = alpha_at(g, h, s, grid.p, smooth=1e3)

@@ -3,7 +3,7 @@
 import pytest
 
 from metainterface.errors import MetainterfaceError
-from metainterface.io.units import (
+from metainterface.physical.units import (
     parse_area,
     parse_force,
     parse_length,

@@ -3,9 +3,10 @@
 import pytest
 import torch
 
-from metainterface.design import builtin_target
-from metainterface.design.levmar import least_squares
-from metainterface.design.refine import TargetGrid, masked_loss, residuals, to_design
+from metainterface.inverse import builtin_target
+from metainterface.inverse.levmar import least_squares
+from metainterface.inverse.params import FULL, HERTZ
+from metainterface.inverse.refine import TargetGrid, masked_loss, residuals
 from metainterface.physics import CellSettings
 
 F64 = torch.float64
@@ -81,9 +82,10 @@ def test_residuals_are_the_exact_loss_and_their_jacobian_its_gradient(hertz):
     grid = TargetGrid.from_curves([(t.p_star, t.alpha) for t in targets], 32)
     gen = torch.Generator().manual_seed(1)
     raw = torch.randn(2, 8 if hertz else 17, generator=gen, dtype=F64) - 1.0
-    r, jac = residuals(raw, s, grid, 0.1, hertz=hertz)
+    param = HERTZ if hertz else FULL
+    r, jac = residuals(raw, s, grid, 0.1, param=param)
     z = raw.clone().requires_grad_(True)
-    loss = masked_loss(*to_design(z, s, hertz), s, grid, None, 0.1)
+    loss = masked_loss(*param.to_design(z, s), s, grid, None, 0.1)
     torch.testing.assert_close((r * r).sum(-1), loss.detach(), rtol=1e-12, atol=0)
     (grad,) = torch.autograd.grad(loss.sum(), z)
     torch.testing.assert_close(2 * (jac.mT @ r[..., None])[..., 0], grad, rtol=1e-9, atol=1e-15)
@@ -93,8 +95,8 @@ def test_residuals_are_the_exact_loss_and_their_jacobian_its_gradient(hertz):
         step = torch.zeros_like(raw)
         step[:, k] = eps
         diff = (
-            residuals(raw + step, s, grid, 0.1, hertz=hertz)[0]
-            - residuals(raw - step, s, grid, 0.1, hertz=hertz)[0]
+            residuals(raw + step, s, grid, 0.1, param=param)[0]
+            - residuals(raw - step, s, grid, 0.1, param=param)[0]
         ) / (2 * eps)
         torch.testing.assert_close(jac[:, :, k], diff, rtol=1e-4, atol=1e-7)
 
@@ -102,7 +104,7 @@ def test_residuals_are_the_exact_loss_and_their_jacobian_its_gradient(hertz):
 def test_the_polish_is_never_worse_than_the_lbfgs_polish():
     # The linear law is not realisable: Levenberg-Marquardt stops above the design tolerance
     # and the L-BFGS polish runs from the same start; the better of the two is kept.
-    from metainterface.design.refine import RefineSettings, polish, refine
+    from metainterface.inverse.refine import RefineSettings, polish, refine
 
     s = CellSettings()
     target = builtin_target("linear")
@@ -112,7 +114,7 @@ def test_the_polish_is_never_worse_than_the_lbfgs_polish():
     rs = RefineSettings(polish_iterations=20)
 
     def loss(x):
-        return masked_loss(*to_design(x, s), s, grid, None, rs.undershoot_weight)
+        return masked_loss(*FULL.to_design(x, s), s, grid, None, rs.undershoot_weight)
 
     both = loss(polish(raw, s, grid, rs))
     lbfgs_only = loss(refine(raw, s, grid, rs.polishing()))
@@ -121,8 +123,8 @@ def test_the_polish_is_never_worse_than_the_lbfgs_polish():
 
 
 def test_an_unknown_polish_method_is_refused_by_name():
-    from metainterface.design.refine import RefineSettings
     from metainterface.errors import MetainterfaceError
+    from metainterface.inverse.refine import RefineSettings
 
     with pytest.raises(MetainterfaceError, match="polish_method must be one of levmar, lbfgs"):
         RefineSettings(polish_method="newton")

@@ -1,16 +1,14 @@
 """Inverse design: targets, batched L-BFGS, refinement meets realisable targets, the CLI."""
 
-import json
-
 import numpy as np
 import pytest
 import torch
 
-from metainterface.cli import main
-from metainterface.design import builtin_target, design, target_from_csv
-from metainterface.design.lbfgs import minimize
-from metainterface.design.refine import RefineSettings, from_design, to_design
 from metainterface.errors import MetainterfaceError
+from metainterface.inverse import builtin_target, design, target_from_csv
+from metainterface.inverse.lbfgs import minimize
+from metainterface.inverse.params import FULL
+from metainterface.inverse.refine import RefineSettings
 from metainterface.physics import CellSettings
 
 S = CellSettings()
@@ -53,7 +51,7 @@ def test_parameterisation_round_trip():
     g = torch.tensor([[2.0, 3.0, 1.9, 3.9]], dtype=torch.float64)
     h = torch.tensor([[0.004, 0.0, 0.01, 0.002]], dtype=torch.float64)
     s4 = CellSettings(n_asperities=4)
-    g2, h2 = to_design(from_design(g, h, s4), s4)
+    g2, h2 = FULL.to_design(FULL.from_design(g, h, s4), s4)
     order = torch.argsort(h, dim=-1)
     np.testing.assert_allclose(h2, h.gather(-1, order), atol=1e-9)
     np.testing.assert_allclose(g2, g.gather(-1, order), atol=1e-3)
@@ -61,9 +59,9 @@ def test_parameterisation_round_trip():
 
 def test_refinement_meets_a_realisable_target_unlike_the_training_categories():
     # a realisable target from a design with alternating shapes and even spacing
-    from metainterface.design.targets import _design_target
+    from metainterface.inverse.targets import design_target_of
 
-    t = _design_target("alt", [1.8, 4.0] * 4 + [2.5], [k / 9 for k in range(9)], "test")
+    t = design_target_of("alt", [1.8, 4.0] * 4 + [2.5], [k / 9 for k in range(9)], "test")
     r = design([t], "multistart", starts=4, seed=1, refine_settings=FAST)[0]
     assert r.error < 0.02 and r.error <= r.initial_error
 
@@ -88,33 +86,6 @@ def test_builtin_targets_and_csv_errors(tmp_path):
             target_from_csv(f)
 
 
-def test_design_cli_writes_outputs(tmp_path, capsys):
-    out = tmp_path / "out"
-    csv = tmp_path / "mine.csv"
-    t = builtin_target("saturating")
-    csv.write_text(
-        "p_star,alpha\n"
-        + "\n".join(f"{p},{a}" for p, a in zip(t.p_star[::8], t.alpha[::8], strict=True))
-    )
-    assert main(["design", "--target-csv", str(csv), "--out", str(out), "--refine", "none"]) == 0
-    folder = out / "mine"
-    for f in ("design.json", "target.csv", "curve.csv", "design.png"):
-        assert (folder / f).is_file(), f
-    data = json.loads((folder / "design.json").read_text())
-    assert data["method"] == "surrogate" and 0 <= data["relative_error"] < 1
-    assert "version" in data["provenance"]
-    assert "surrogate" in capsys.readouterr().out
-
-
-def test_design_cli_bad_input(tmp_path, capsys):
-    bad = tmp_path / "bad.csv"
-    bad.write_text("p_star,alpha\n0,0\n1e-4,0.01\n0.5e-4,0.02\n")
-    out = tmp_path / "o"
-    assert main(["design", "--target-csv", str(bad), "--out", str(out)]) == 2
-    assert "row 3" in capsys.readouterr().err and not out.exists()
-    assert main(["design", "--target", "nope", "--out", str(out)]) == 2
-
-
 def test_hedge_starts_are_refined_with_the_zero_shot_one():
     t = [builtin_target("bilinear")]
     pure = design(t, "surrogate", refine_settings=FAST)[0]
@@ -122,46 +93,6 @@ def test_hedge_starts_are_refined_with_the_zero_shot_one():
     assert pure.start == 0 and 0 <= hedged.start <= 3
     assert hedged.initial_error == pytest.approx(pure.initial_error)  # the zero-shot row's
     assert hedged.error < 0.05
-
-
-def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, capsys):
-    # friction grows with load, sub-linearly; tau = 0.25 MPa, E* = 2 MPa, A = 4 cm^2
-    loads = np.linspace(0.0, 1.2, 12)  # N; P* = F / (A E*) up to 1.5e-3
-    friction = 0.25e6 * 4e-4 * 0.06 * (loads / loads[-1]) ** 0.7  # alpha up to 0.06
-    csv = tmp_path / "law.csv"
-    csv.write_text(
-        "normal_force,friction_force\n"
-        + "\n".join(f"{n},{f}" for n, f in zip(loads, friction, strict=True))
-    )
-    out = tmp_path / "out"
-    args = [
-        "design",
-        "--friction-csv",
-        str(csv),
-        "--shear-strength",
-        "0.25MPa",
-        "--modulus",
-        "2MPa",
-        "--radius",
-        "0.5mm",
-        "--area",
-        "4cm2",
-        "--out",
-        str(out),
-        "--refine",
-        "none",
-        "--max-pressure",
-        "0.5",
-    ]
-    assert main(args) == 0, capsys.readouterr().err
-    data = json.loads((out / "law" / "design.json").read_text())
-    assert data["physical"]["radius_m"] == pytest.approx(5e-4)
-    assert data["physical"]["n_cells"] == pytest.approx(4e-4 / data["physical"]["cell_area_m2"])
-    assert data["pressure_check"]["limit_p_over_e_star"] == pytest.approx(0.5)
-    assert "friction" in data["target"]
-    np.testing.assert_allclose(data["target"]["alpha"][-1], 0.06, rtol=1e-9)
-    assert main([*args[:-4], "--modulus", "2mm"]) == 2  # a length is not a stress
-    assert "modulus" in capsys.readouterr().err
 
 
 def test_fallback_multistart_for_targets_the_surrogate_misses():
@@ -178,10 +109,10 @@ def test_fallback_multistart_for_targets_the_surrogate_misses():
 
 
 def test_random_starts_are_nested_and_the_same_for_every_target():
-    from metainterface.design.pipeline import _starts
+    from metainterface.inverse.pipeline import random_starts
 
-    g8, h8 = _starts(8, 3, S, seed=5, hertz=False)
-    g3, h3 = _starts(3, 1, S, seed=5, hertz=False)
+    g8, h8 = random_starts(8, 3, S, seed=5, param=FULL)
+    g3, h3 = random_starts(3, 1, S, seed=5, param=FULL)
     assert g8.shape == (24, 9)
     torch.testing.assert_close(g8[:8], g8[16:])  # target 0 and target 2
     torch.testing.assert_close(g8[:3], g3)  # the first 3 of 8 starts are the 3 starts
@@ -202,16 +133,16 @@ def test_a_targets_design_does_not_depend_on_the_batch(method):
 
 
 def test_hedge_starts_jitter_the_zero_shot_design():
-    from metainterface.design.pipeline import JITTER_GAMMA, _hedge_starts, _starts
+    from metainterface.inverse.pipeline import JITTER_GAMMA, hedge_starts, random_starts
 
     g0 = torch.full((2, 9), 3.0, dtype=torch.float64)
     h0 = torch.linspace(0, 0.5 * S.delta_max, 9, dtype=torch.float64).expand(2, 9)
-    g, h = _hedge_starts(g0, h0, 5, S, seed=0)
+    g, h = hedge_starts(g0, h0, 5, S, seed=0)
     assert g.shape == h.shape == (2, 5, 9)
     # three jittered copies around the zero-shot design, then the first two random starts
     spread = (g[:, :3] - 3.0).std()
     assert 0.3 * JITTER_GAMMA * 2.2 < float(spread) < 3 * JITTER_GAMMA * 2.2
-    g_r, h_r = _starts(2, 1, S, seed=0, hertz=False)
+    g_r, h_r = random_starts(2, 1, S, seed=0, param=FULL)
     torch.testing.assert_close(g[0, 3:], g_r)
     torch.testing.assert_close(h[1, 3:], h_r)
     assert float(h.min()) >= 0
@@ -220,7 +151,7 @@ def test_hedge_starts_jitter_the_zero_shot_design():
 def test_a_start_on_the_bounds_can_still_move():
     # gammas on both bounds and all gaps 0, what the surrogate outputs for the linear law:
     # within 1e-4 of the bounds the sigmoid and softplus were flat and L-BFGS never moved
-    from metainterface.design.refine import TargetGrid, refine, relative_error
+    from metainterface.inverse.refine import TargetGrid, refine, relative_error
 
     target = builtin_target("linear")
     grid = TargetGrid.from_curves([(target.p_star, target.alpha)], 128)
@@ -228,6 +159,6 @@ def test_a_start_on_the_bounds_can_still_move():
     h = torch.zeros(1, 9, dtype=torch.float64)
     h[0, -1] = 1.1 * S.delta_max
     before = float(relative_error(gamma, h, S, grid))
-    raw = refine(from_design(gamma, h, S), S, grid, FAST)
-    after = float(relative_error(*to_design(raw, S), S, grid))
+    raw = refine(FULL.from_design(gamma, h, S), S, grid, FAST)
+    after = float(relative_error(*FULL.to_design(raw, S), S, grid))
     assert before > 1.0 and after < 0.15

@@ -1,0 +1,406 @@
+"""The public functions: design, compare, curve, export, physical. numpy and lists in,
+numpy out; every argument checked with a one-line MetainterfaceError."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from metainterface import _checks
+from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve
+from metainterface.errors import MetainterfaceError
+from metainterface.inverse import pipeline
+from metainterface.inverse.targets import Target
+from metainterface.physical.dimensions import physical_block
+from metainterface.physical.units import (
+    parse_area,
+    parse_force,
+    parse_length,
+    parse_pressure,
+    parse_pressure_limit,
+)
+from metainterface.physics.cell import CellSettings, Design
+from metainterface.physics.limits import PressureCheck, check_pressure, pressure_penalty
+from metainterface.physics.models import ForwardModel, get_model
+
+#: Upper bounds that keep a request within this machine's memory and a sane run time.
+MAX_STARTS = 10_000
+MAX_STEPS = 1_000_000
+MAX_SEED = 2**63 - 1
+#: Weight of the pressure-limit penalty added to the refinement's loss.
+PRESSURE_WEIGHT = 10.0
+
+
+def _targets(targets: Target | str | Sequence[Target | str]) -> tuple[list[Target], bool]:
+    """The targets as a list, and whether one was given alone (then one result back)."""
+    single = isinstance(targets, Target | str)
+    items = [targets] if single else list(targets)  # type: ignore[arg-type]
+    if not items:
+        raise MetainterfaceError("targets: give at least one target")
+    out = []
+    for t in items:
+        if isinstance(t, str):
+            t = Target.builtin(t)
+        if not isinstance(t, Target):
+            raise MetainterfaceError(
+                f"targets must be Target objects or built-in names ({', '.join(Target.builtins())})"
+                f", got {type(t).__name__}"
+            )
+        out.append(t)
+    names = [t.name for t in out]
+    if len(set(names)) != len(names):
+        raise MetainterfaceError(f"target names must be distinct, got {', '.join(names)}")
+    return out, single
+
+
+def _limit(max_pressure: float | str | None, modulus: str | float | None) -> float | None:
+    if max_pressure is None:
+        return None
+    e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
+    return parse_pressure_limit(max_pressure, e_star=e_star, option="max_pressure")
+
+
+def design(
+    targets: Target | str | Sequence[Target | str],
+    *,
+    method: str = "surrogate",
+    starts: int = 50,
+    hedge: int = 8,
+    fallback: int = 50,
+    seed: int = 0,
+    model: str | ForwardModel | None = None,
+    settings: CellSettings | None = None,
+    surrogate: str | os.PathLike[str] | None = None,
+    refine: bool = True,
+    max_pressure: float | str | None = None,
+    modulus: str | float | None = None,
+    out: str | os.PathLike[str] | None = None,
+    radius: str | float | None = None,
+    total_force: str | float | None = None,
+    area: str | float | None = None,
+    meta: dict[str, Any] | None = None,
+) -> DesignResult | list[DesignResult]:
+    """Design a unit cell whose alpha(P*) follows each target.
+
+    Parameters
+    ----------
+    targets : Target, str or list of them
+        A target, a built-in name (``"saturating"``, ``"bilinear"``, ``"linear"``), or a list;
+        a list gives a list of results, designed in one batch.
+    method : {"surrogate", "multistart", "hertz"}
+        Zero-shot prediction by the surrogate then refinement (default), ``starts`` random
+        starts refined and the best kept, or the Hertz-only baseline (gamma = 2, heights only).
+    starts : int
+        Random starts of the multistart and Hertz methods, in [1, 10000].
+    hedge : int
+        Surrogate method: extra starts refined beside the prediction (half jittered copies of
+        it, half random), in [0, 10000]; 0 is the paper's pure pipeline.
+    fallback : int
+        Surrogate method: a target still missed by more than 2 % also gets a multistart with
+        this many starts, the better design kept; 0 turns it off.
+    seed : int
+        Seed of every random draw, in [0, 2**63 - 1]; the same seed gives the same designs.
+    model : str or ForwardModel
+        The forward model refined and measured with: ``"independent"`` (the paper's,
+        default), ``"interacting"``, or an instance such as ``Interacting(curvature=True)``.
+    settings : CellSettings
+        The design space (N, gamma bounds, Delta_max). The shipped surrogate covers the
+        paper's cell; for another one the multistart runs instead (``result.notes``).
+    surrogate : path
+        A surrogate model file (``metainterface train``), default the shipped one.
+    refine : bool
+        Refine the starts (False: the zero-shot prediction or the best raw start).
+    max_pressure : float or str
+        A peak contact pressure limit: p/E* in (0, 1], or a stress ('50MPa') with
+        ``modulus``. Adds a penalty to the refinement and a check to each result.
+    modulus : str or float
+        E* of the material pair ('2MPa', or Pa), for ``max_pressure`` and the SI block.
+    out : path
+        Write each result's files here (one target: into ``out``; several: ``out/<name>``).
+    radius, total_force, area : str or float
+        With ``modulus``, ``radius`` R ('0.5mm') adds the design's dimensions in SI to
+        design.json, and the number of cells for a total force ('10N') or an area ('4cm2').
+    meta : dict
+        Extra JSON-ready keys stored in each design.json (e.g. the command line).
+
+    Returns
+    -------
+    DesignResult or list of DesignResult
+        One per target, in order.
+    """
+    items, single = _targets(targets)
+    _checks.choice("method", method, pipeline.METHODS)
+    starts = _checks.whole("starts", starts, low=1, high=MAX_STARTS)
+    hedge = _checks.whole("hedge", hedge, low=0, high=MAX_STARTS)
+    fallback = _checks.whole("fallback", fallback, low=0, high=MAX_STARTS)
+    seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
+    if settings is not None and not isinstance(settings, CellSettings):
+        raise MetainterfaceError("settings must be a CellSettings")
+    if not isinstance(refine, bool):
+        raise MetainterfaceError(f"refine must be True or False, got {refine!r}")
+    fm = get_model(model)
+    limit = _limit(max_pressure, modulus)
+    extra_loss = None
+    if limit is not None:
+
+        def extra_loss(gamma, h, cell, limit=limit):
+            return PRESSURE_WEIGHT * pressure_penalty(gamma, h, cell, limit)
+
+    physical = _physical_options(radius, modulus, total_force, area)
+    raw = pipeline.design(
+        items,
+        method,
+        refine_designs=refine,
+        settings=settings,
+        model_path=surrogate,
+        starts=starts,
+        seed=seed,
+        extra_loss=extra_loss,
+        model=fm,
+        hedge=hedge if method == "surrogate" else 0,
+        fallback=fallback if method == "surrogate" else 0,
+    )
+    results = [_public(r, limit, modulus) for r in raw]
+    if out is not None:
+        out = Path(out)
+        folders = [out] if single else [out / r.target.name for r in results]
+        _save_all(results, folders, physical, meta)
+    return results[0] if single else results
+
+
+def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> DesignResult:
+    d = Design(gamma=r.gamma, h=r.h, settings=r.settings)
+    notes = (*r.notes, *pipeline.reachability_warnings(r.target, r.settings))
+    pressure = None
+    if limit is not None:
+        e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
+        pressure = check_pressure(d, limit if e_star is None else limit * e_star, e_star=e_star)
+    return DesignResult(
+        target=r.target,
+        design=d,
+        error=r.error,
+        initial_error=r.initial_error,
+        method=r.method,
+        seconds=r.seconds,
+        model=r.model,
+        start=r.start,
+        fallback=r.fallback,
+        notes=notes,
+        pressure=pressure,
+    )
+
+
+def _physical_options(radius: Any, modulus: Any, total_force: Any, area: Any) -> dict | None:
+    """Parsed SI options of the physical block, or None without radius and modulus."""
+    if radius is None or modulus is None:
+        if total_force is not None or area is not None:
+            raise MetainterfaceError("total_force and area need radius and modulus too")
+        return None
+    if total_force is not None and area is not None:
+        raise MetainterfaceError("give total_force or area, not both")
+    return {
+        "radius": parse_length(radius, option="radius"),
+        "e_star": parse_pressure(modulus, option="modulus"),
+        "total_force": None
+        if total_force is None
+        else parse_force(total_force, option="total_force"),
+        "area": None if area is None else parse_area(area, option="area"),
+    }
+
+
+def _save_all(
+    results: list[DesignResult],
+    folders: list[Path],
+    physical: dict | None,
+    meta: dict[str, Any] | None,
+) -> None:
+    for r, folder in zip(results, folders, strict=True):
+        extra = {"command": meta} if meta else {}
+        if physical is not None:
+            extra["physical"] = physical_block(r.design, **physical)
+        r.save(folder, **extra)
+
+
+def compare(
+    targets: Target | str | Sequence[Target | str],
+    *,
+    out: str | os.PathLike[str] | None = None,
+    **options: Any,
+) -> dict[str, list[DesignResult]]:
+    """Design every target with all three methods (paper fig. 5): {method: [results]}.
+
+    ``options`` are those of :func:`design`; with ``out``, each method's files go to
+    ``out/<target>/<method>/`` and the comparison figure to ``out/<target>/compare.png``.
+    """
+    items, _ = _targets(targets)
+    if "method" in options:
+        raise MetainterfaceError("compare runs every method; leave method out")
+    meta = options.pop("meta", None)
+    physical = _physical_options(
+        options.pop("radius", None),
+        options.get("modulus"),
+        options.pop("total_force", None),
+        options.pop("area", None),
+    )
+    by_method = {
+        m: design(items, method=m, **options)  # type: ignore[misc]
+        for m in pipeline.METHODS
+    }
+    if out is not None:
+        from metainterface.plots import plot_comparison, save_figure
+
+        out = Path(out)
+        for i, t in enumerate(items):
+            per = [by_method[m][i] for m in pipeline.METHODS]
+            _save_all(per, [out / t.name / r.method for r in per], physical, meta)
+            fig = plot_comparison([per], [[r.curve() for r in per]])
+            save_figure(fig, out / t.name / "compare.png", command="compare")
+    return by_method  # type: ignore[return-value]
+
+
+def _as_design(
+    design: Design | str | os.PathLike[str] | None,
+    gamma: Any,
+    h: Any,
+    settings: CellSettings | None,
+) -> Design:
+    """A Design from a Design, a design file, or gamma and h lists."""
+    if design is not None:
+        if gamma is not None or h is not None:
+            raise MetainterfaceError("give a design or gamma and h, not both")
+        if isinstance(design, Design):
+            return design
+        if isinstance(design, str | os.PathLike):
+            return Design.load(design)
+        raise MetainterfaceError(
+            f"design must be a Design or a design file path, got {type(design).__name__}"
+        )
+    if gamma is None or h is None:
+        raise MetainterfaceError("give a design, or both gamma and h")
+    if settings is not None and not isinstance(settings, CellSettings):
+        raise MetainterfaceError("settings must be a CellSettings")
+    return Design(gamma=gamma, h=h, settings=settings or CellSettings())
+
+
+def curve(
+    design: Design | str | os.PathLike[str] | None = None,
+    *,
+    gamma: Sequence[float] | np.ndarray | None = None,
+    h: Sequence[float] | np.ndarray | None = None,
+    settings: CellSettings | None = None,
+    model: str | ForwardModel | None = None,
+    steps: int = CURVE_STEPS,
+    smooth: float | None = None,
+) -> Curve:
+    """The alpha(P*) and S*(P*) curve of a design along Delta in [0, Delta_max].
+
+    Parameters
+    ----------
+    design : Design or path
+        The design, or a design file; or give ``gamma`` and ``h`` instead.
+    gamma, h : list or array, shape (N,)
+        Shape exponents and height offsets [units of R], N a perfect square.
+    settings : CellSettings
+        The cell of ``gamma`` and ``h`` (default: the paper's).
+    model : str or ForwardModel
+        The forward model (default ``"independent"``).
+    steps : int
+        Delta samples, in [2, 1000000].
+    smooth : float
+        Softplus steepness kappa_s [1/R] instead of the exact bracket.
+
+    Returns
+    -------
+    Curve
+        numpy ``delta``, ``p_star``, ``alpha``, ``stiffness`` (steps,).
+    """
+    d = _as_design(design, gamma, h, settings)
+    steps = _checks.whole("steps", steps, low=2, high=MAX_STEPS)
+    if smooth is not None:
+        smooth = _checks.number("smooth", smooth, low=0.0, low_open=True)
+    return design_curve(d, model, steps=steps, smooth=smooth)
+
+
+def export(
+    design: Design | str | os.PathLike[str],
+    path: str | os.PathLike[str],
+    *,
+    radius: str | float,
+    tiles: tuple[int, int] | str = (1, 1),
+    format: str | None = None,
+    resolution: float | None = None,
+    base: str | float = "1mm",
+) -> dict[str, Any]:
+    """Write the design's surface for manufacture: STL (mm), 16-bit PNG/TIFF or NPY (m).
+
+    Parameters
+    ----------
+    design : Design or path
+    path : path
+        Output file; its suffix picks the format unless ``format`` is given. A sidecar
+        ``path.json`` records the height scale, grid and provenance.
+    radius : str or float
+        Asperity radius R ('0.5mm', or metres).
+    tiles : (nx, ny) or 'NXxNY'
+        Cells along x and y.
+    format : {"stl", "png", "tiff", "npy"}
+    resolution : float
+        Grid points per mm (default 64 per asperity pitch).
+    base : str or float
+        STL base plate thickness under the surface (default 1 mm).
+
+    Returns
+    -------
+    dict
+        The sidecar record (size, grid, triangles, ...).
+    """
+    from metainterface.io.export import export_design
+
+    d = _as_design(design, None, None, None)
+    if resolution is not None:
+        resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
+    source = str(design) if isinstance(design, str | os.PathLike) else None
+    return export_design(
+        d,
+        path,
+        radius=parse_length(radius, option="radius"),
+        tiles=tiles,
+        fmt=format,
+        resolution=resolution,
+        base=parse_length(base, option="base"),
+        source=source,
+    )
+
+
+def physical(
+    design: Design,
+    *,
+    radius: str | float,
+    modulus: str | float,
+    total_force: str | float | None = None,
+    area: str | float | None = None,
+) -> dict[str, Any]:
+    """The design in SI units for an asperity radius and a modulus (paper sec. 2.3): the
+    pressure at P*_max, heights, cell side and, for a total force or an area, the number of
+    unit cells. Keys end in their unit (_m, _m2, _pa, _n)."""
+    opts = _physical_options(radius, modulus, total_force, area)
+    assert opts is not None
+    return physical_block(_as_design(design, None, None, None), **opts)
+
+
+def pressure_check(
+    design: Design, max_pressure: float | str, *, modulus: str | float | None = None
+) -> PressureCheck:
+    """Each asperity's peak contact pressure at Delta_max against a limit (p/E*, or a stress
+    with ``modulus``): which asperities would yield."""
+    limit = _limit(max_pressure, modulus)
+    assert limit is not None
+    d = _as_design(design, None, None, None)
+    if modulus is None:
+        return check_pressure(d, limit)
+    e_star = parse_pressure(modulus, option="modulus")
+    return check_pressure(d, limit * e_star, e_star=e_star)

@@ -1,0 +1,75 @@
+"""Your own design space: a dataset for a cell, a surrogate trained on it, its evaluation."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from metainterface import _checks
+from metainterface.data import generate_dataset as _generate
+from metainterface.data import load_dataset
+from metainterface.data.dataset import GenerationReport
+from metainterface.physics.cell import CellSettings
+from metainterface.surrogate.checkpoint import default_model_path, load_model
+from metainterface.surrogate.data import split_of
+from metainterface.surrogate.evaluate import evaluate
+from metainterface.surrogate.loss import weights_of
+from metainterface.surrogate.train import TrainConfig, TrainResult, train
+
+#: Largest dataset one call makes (~1.2 kB a sample on disk and in memory).
+MAX_SAMPLES = 10_000_000
+
+
+def generate_dataset(
+    samples: int,
+    out: str | os.PathLike[str],
+    *,
+    seed: int = 0,
+    settings: CellSettings | None = None,
+    progress: bool = True,
+) -> GenerationReport:
+    """Generate a training dataset: ``samples`` designs of the paper's six topography
+    categories with their exact normalised curves, split 80/10/10, written atomically to
+    ``out`` (.npz). The same (samples, seed, settings) give the same arrays."""
+    samples = _checks.whole("samples", samples, low=1, high=MAX_SAMPLES)
+    seed = _checks.whole("seed", seed, low=0, high=2**63 - 1)
+    return _generate(samples, seed, settings or CellSettings(), out, progress=progress)
+
+
+def train_surrogate(
+    dataset: str | os.PathLike[str],
+    out: str | os.PathLike[str],
+    config: TrainConfig | None = None,
+    *,
+    resume: bool = False,
+    progress: bool = True,
+) -> TrainResult:
+    """Train the inverse network on a dataset (``generate_dataset``) into the run folder
+    ``out``: one atomic checkpoint per epoch (``resume=True`` continues), the best model as
+    ``out/model.pt``, usable as ``design(..., surrogate=out / "model.pt")``."""
+    ds = load_dataset(dataset)
+    return train(
+        split_of(ds, "train"),
+        split_of(ds, "val"),
+        ds.settings,
+        out,
+        config,
+        resume=resume,
+        progress=progress,
+        dataset_info={"path": str(dataset), "samples": len(ds), "seed": ds.seed},
+    )
+
+
+def evaluate_surrogate(
+    dataset: str | os.PathLike[str], surrogate: str | os.PathLike[str] | None = None
+) -> dict[str, Any]:
+    """Zero-shot errors of a surrogate on a dataset's test split, per category and overall
+    (median and 90th-percentile relative curve error, log10 errors of P*_max and alpha_max)
+    and the train/test loss gap."""
+    path = Path(surrogate) if surrogate is not None else default_model_path()
+    model, settings, config = load_model(path)
+    ds = load_dataset(dataset, settings)
+    return evaluate(
+        model, split_of(ds, "train"), split_of(ds, "test"), settings, weights_of(config)
+    )

@@ -1,0 +1,98 @@
+"""How the refinement's unbounded parameters map to designs (paper appendix C).
+
+gamma = gamma_min + (gamma_max - gamma_min) sigmoid(r_gamma) and heights
+h = [0, Delta_max softplus(r_h)] (the first asperity is the anchor at h = 0), re-sorted at
+every evaluation with each gamma kept with its h. A parameterisation with ``fixed_gamma``
+optimises the heights only: the Hertz-only baseline is ``HERTZ`` (gamma = 2 everywhere).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+from torch import Tensor
+from torch.nn import functional as nnf
+
+from metainterface.errors import MetainterfaceError
+from metainterface.physics.cell import CellSettings
+
+DTYPE = torch.float64
+
+#: How far inside the bounds :meth:`Parameterisation.from_design` puts a start: gamma at
+#: least this fraction of its range from either bound, height gaps at least this fraction of
+#: Delta_max. Closer, the sigmoid and softplus flatten and a start on a bound cannot move.
+START_MARGIN = 0.01
+
+
+@dataclass(frozen=True)
+class Parameterisation:
+    """Unbounded parameters (B, D) <-> designs (gamma, h) (B, N).
+
+    fixed_gamma: None to optimise gamma and h (D = 2N - 1), or a shape exponent that every
+    asperity keeps while only the heights move (D = N - 1).
+    """
+
+    fixed_gamma: float | None = None
+
+    def __post_init__(self) -> None:
+        g = self.fixed_gamma
+        if g is not None and not (isinstance(g, int | float) and 1.0 < g < float("inf")):
+            raise MetainterfaceError(f"fixed_gamma must be a number > 1, got {g!r}")
+
+    def size(self, n_asperities: int) -> int:
+        """D, the number of unbounded parameters of an N-asperity design."""
+        return n_asperities - 1 if self.fixed_gamma is not None else 2 * n_asperities - 1
+
+    def to_design(
+        self, raw: Tensor, settings: CellSettings, *, sort: bool = True
+    ) -> tuple[Tensor, Tensor]:
+        """(B, D) -> (gamma, h) (B, N), sorted by height with each gamma kept with its h.
+
+        The losses skip the sort (``sort=False``) where the model does not place asperities
+        (a sum over independent ones does not depend on their order)."""
+        n = settings.n_asperities
+        if self.fixed_gamma is not None:
+            r_h = raw
+            gamma = torch.full((raw.shape[0], n), float(self.fixed_gamma), dtype=raw.dtype)
+        else:
+            r_g, r_h = raw[:, :n], raw[:, n:]
+            span = settings.gamma_max - settings.gamma_min
+            gamma = settings.gamma_min + span * torch.sigmoid(r_g)
+        gaps = settings.delta_max * nnf.softplus(r_h)
+        h = torch.cat([torch.zeros_like(r_h[:, :1]), gaps], dim=-1)
+        if not sort:
+            return gamma, h
+        h, order = torch.sort(h, dim=-1)
+        return gamma.gather(-1, order), h
+
+    def from_design(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Tensor:
+        """Inverse of :meth:`to_design` for (B, N) designs, ``START_MARGIN`` inside the
+        bounds."""
+        order = torch.argsort(h, dim=-1)
+        gamma, h = gamma.gather(-1, order), h.gather(-1, order)
+        h = (h - h[:, :1])[:, 1:] / settings.delta_max
+        r_h = torch.log(torch.expm1(h.clamp_min(START_MARGIN)))
+        if self.fixed_gamma is not None:
+            return r_h.to(DTYPE)
+        u = ((gamma - settings.gamma_min) / (settings.gamma_max - settings.gamma_min)).clamp(
+            START_MARGIN, 1 - START_MARGIN
+        )
+        return torch.cat([torch.logit(u), r_h], dim=-1).to(DTYPE)
+
+    def random(self, count: int, settings: CellSettings, generator: torch.Generator):
+        """``count`` random designs (gamma, h), each (count, N): gamma uniform in its bounds
+        (or fixed), h uniform in [0, Delta_max]; each drawn whole (gamma then h), so the first
+        k of K draws are the k draws."""
+        n = settings.n_asperities
+        u = torch.rand((count, 2 * n), generator=generator, dtype=DTYPE)
+        gamma = settings.gamma_min + (settings.gamma_max - settings.gamma_min) * u[:, :n]
+        if self.fixed_gamma is not None:
+            gamma = torch.full_like(gamma, float(self.fixed_gamma))
+        return gamma, settings.delta_max * u[:, n:]
+
+
+#: gamma and h both free: the paper's design space.
+FULL = Parameterisation()
+#: The Hertz-only baseline: every asperity a paraboloid (gamma = 2), heights only.
+HERTZ = Parameterisation(fixed_gamma=2.0)

@@ -1,0 +1,42 @@
+"""Physical units at the edges of the scale-free core.
+
+Quantities parsed with pint (``units``), a friction law in newtons turned into an alpha(P*)
+target and back (``friction``, Bowden-Tabor), and the dimensions of a design in SI for a
+given asperity radius and modulus (``dimensions``).
+"""
+
+from metainterface.physical.dimensions import physical_block
+from metainterface.physical.friction import (
+    FrictionLaw,
+    FrictionTarget,
+    alpha_to_friction,
+    friction_target,
+    friction_target_from_options,
+    friction_to_alpha,
+    read_friction_csv,
+)
+from metainterface.physical.units import (
+    parse_area,
+    parse_force,
+    parse_length,
+    parse_pressure,
+    parse_pressure_limit,
+    parse_quantity,
+)
+
+__all__ = [
+    "FrictionLaw",
+    "FrictionTarget",
+    "alpha_to_friction",
+    "friction_target",
+    "friction_target_from_options",
+    "friction_to_alpha",
+    "parse_area",
+    "parse_force",
+    "parse_length",
+    "parse_pressure",
+    "parse_pressure_limit",
+    "parse_quantity",
+    "physical_block",
+    "read_friction_csv",
+]

@@ -1,0 +1,317 @@
+"""Forward models as objects, and the one registry every command reads.
+
+A forward model maps (B, N) designs to their response along a Delta sweep. Two ship:
+
+    Independent()                 the paper's superposition of Sneddon contacts (sec. 2.2)
+    Interacting(curvature=False)  the same with the lattice's elastic field (``interaction``)
+
+Each implements ``sweep`` and ``asperity_sweep`` (and may give a cheaper ``load_area``);
+everything else (curves, alpha at given pressures, the dense curve that BEM results are
+compared with) is derived once, in :class:`ForwardModel`. ``MODELS`` maps names to
+instances; ``register_model`` adds one, and it is then accepted by ``design``, ``curve``,
+``validate`` and the CLI's ``--model`` choices alike.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, fields, is_dataclass
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from metainterface.errors import MetainterfaceError
+from metainterface.physics import curves
+from metainterface.physics.cell import CellSettings, Design
+from metainterface.physics.curves import Curve, Sweep, anchor, delta_grid, interp, to_grid
+from metainterface.physics.interaction import (
+    CURVATURE,
+    ITERATIONS,
+    asperity_sweep_interacting,
+    load_area_interacting,
+    sweep_interacting,
+)
+from metainterface.physics.sneddon import area
+
+#: Delta samples of the dense sweep that BEM loads are interpolated on (:meth:`model_curve`).
+N_DELTA_DENSE = 8193
+
+
+@dataclass(frozen=True)
+class ModelCurve:
+    """A model's response to one design along a dense Delta sweep (float64 numpy).
+
+    p_star: (K,) non-decreasing P* = P / E*, ending at the load reached at Delta_max.
+    alpha: (K,) contact-area fraction. asperity_alpha: (K, N) each asperity's contact
+    area / A_nom (sums to alpha), or None if the model does not resolve it.
+    """
+
+    p_star: np.ndarray
+    alpha: np.ndarray
+    asperity_alpha: np.ndarray | None = None
+
+    @property
+    def p_star_max(self) -> float:
+        """P* at Delta_max: the largest load the design reaches."""
+        return float(self.p_star[-1])
+
+    def at(self, p_star: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """alpha (Q,) and asperity alpha (Q, N) (or None) at the loads ``p_star`` (Q,)."""
+        xq = torch.as_tensor(np.asarray(p_star, dtype=np.float64))[None]
+        xp = torch.as_tensor(self.p_star)[None]
+        alpha = interp(xq, xp, torch.as_tensor(self.alpha)[None])[0].numpy()
+        if self.asperity_alpha is None:
+            return alpha, None
+        per = torch.as_tensor(self.asperity_alpha).T  # (N, K): one row per asperity
+        cols = interp(xq.expand(per.shape[0], -1), xp.expand(per.shape[0], -1), per)
+        return alpha, cols.T.numpy()
+
+
+class ForwardModel(ABC):
+    """The protocol of a forward model: subclass it, implement the two sweeps, register it.
+
+    All tensors carry a leading batch axis: gamma, h (B, N) with h in units of R; delta (K,)
+    or (B, K) [units of R]; results (B, K). ``smooth`` is the softplus steepness kappa_s
+    [1/R] (None: the exact Macaulay bracket).
+    """
+
+    #: The name under which the model is registered and recorded in output files.
+    name: str = ""
+    #: Whether the response depends on which lattice cell each asperity sits in (then the
+    #: refinement keeps asperity k in cell k; otherwise it may reorder them freely).
+    placed: bool = True
+
+    @abstractmethod
+    def sweep(
+        self,
+        gamma: Tensor,
+        h: Tensor,
+        settings: CellSettings,
+        *,
+        smooth: float | None = None,
+        n_delta: int | None = None,
+        delta: Tensor | None = None,
+    ) -> Sweep:
+        """P*, alpha and S* = dP*/dalpha (B, K) along the sweep, differentiable."""
+
+    @abstractmethod
+    def asperity_sweep(
+        self,
+        gamma: Tensor,
+        h: Tensor,
+        settings: CellSettings,
+        *,
+        n_delta: int | None = None,
+        delta: Tensor | None = None,
+    ) -> tuple[Sweep, Tensor]:
+        """The exact sweep and each asperity's contact area / A_nom, (B, K, N)."""
+
+    def load_area(
+        self,
+        gamma: Tensor,
+        h: Tensor,
+        settings: CellSettings,
+        *,
+        smooth: float | None = None,
+        n_delta: int | None = None,
+        delta: Tensor | None = None,
+    ) -> Sweep:
+        """The sweep where only P* and alpha are needed (S* may be NaN); a model overrides
+        it where leaving S* out is cheaper."""
+        return self.sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta)
+
+    @property
+    def label(self) -> str:
+        """The model and its options as recorded in files: ``interacting(curvature=True)``."""
+        if not is_dataclass(self):
+            return self.name
+        opts = [
+            f"{f.name}={getattr(self, f.name)!r}"
+            for f in fields(self)
+            if getattr(self, f.name) != f.default
+        ]
+        return f"{self.name}({', '.join(opts)})" if opts else self.name
+
+    # --- derived, the same for every model -----------------------------------------------
+
+    def curve(
+        self,
+        gamma: Tensor,
+        h: Tensor,
+        settings: CellSettings,
+        *,
+        smooth: float | None = None,
+        n_delta: int | None = None,
+    ) -> Curve:
+        """alpha and S* of (B, N) designs on settings.n_steps uniform pressures."""
+        sw = self.sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta)
+        return to_grid(sw, settings.n_steps)
+
+    def design_sweep(
+        self, design: Design, *, n_delta: int | None = None, smooth: float | None = None
+    ) -> Sweep:
+        """The float64 sweep of one Design: delta (K,), the rest (1, K)."""
+        gamma, h = design.tensors(torch.float64)
+        return self.sweep(gamma, h, design.settings, smooth=smooth, n_delta=n_delta)
+
+    def alpha_at(
+        self,
+        gamma: Tensor,
+        h: Tensor,
+        settings: CellSettings,
+        p_star: Tensor,
+        *,
+        smooth: float | None = None,
+        n_delta: int | None = None,
+        exact: bool = False,
+    ) -> tuple[Tensor, Tensor]:
+        """alpha (B, M) at the pressures p_star (B, M) and P*_max (B,); alpha is held at its
+        last value beyond P*_max. Interpolated in an ``n_delta`` sweep, or, with ``exact``
+        (exact law only), solved for P*(Delta) = p_star by Newton with exact gradients."""
+        fn = self.sweep if exact else self.load_area
+        return curves.alpha_at(
+            gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta, sweep_fn=fn, exact=exact
+        )
+
+    def alpha_at_loads(
+        self,
+        gamma: Tensor,
+        h: Tensor,
+        settings: CellSettings,
+        p_star: Tensor,
+        *,
+        n_delta: int = 2049,
+        max_extend: int = 6,
+    ) -> Tensor:
+        """alpha (B, Q) at the pressures p_star (B, Q), running the exact sweep past
+        Delta_max (doubling its range at most ``max_extend`` times) until it covers them.
+
+        For comparing models at one set of loads: they reach different P* at Delta_max.
+        """
+        top = p_star.max(dim=-1).values
+        span = settings.delta_max
+        for _ in range(max_extend + 1):
+            delta = torch.linspace(0.0, span, n_delta, dtype=gamma.dtype, device=gamma.device)
+            sw = self.load_area(gamma, h, settings, delta=delta)
+            if bool((sw.p_star[:, -1] >= top).all()):
+                return interp(p_star, sw.p_star, sw.alpha)
+            span *= 2.0
+        raise MetainterfaceError(
+            f"P* up to {float(top.max()):.4g} is not reached by the {self.label} model "
+            f"within Delta <= {span / 2:.4g}"
+        )
+
+    def model_curve(self, design: Design, n_delta: int = N_DELTA_DENSE) -> ModelCurve:
+        """The dense exact curve of one design, with each asperity's area (for BEM)."""
+        gamma, h = design.tensors(torch.float64)
+        with torch.no_grad():
+            sw, per = self.asperity_sweep(
+                gamma, h, design.settings, delta=delta_grid(design.settings, n_delta)
+            )
+        curve = ModelCurve(
+            p_star=sw.p_star[0].numpy(), alpha=sw.alpha[0].numpy(), asperity_alpha=per[0].numpy()
+        )
+        if not (curve.p_star.size >= 2 and curve.p_star_max > 0):
+            raise MetainterfaceError(f"model {self.label!r} gives no load up to Delta_max")
+        return curve
+
+
+@dataclass(frozen=True, repr=True)
+class Independent(ForwardModel):
+    """The paper's model: independent Sneddon asperities, summed (sec. 2.2)."""
+
+    name = "independent"
+    placed = False
+
+    def sweep(self, gamma, h, settings, *, smooth=None, n_delta=None, delta=None) -> Sweep:
+        return curves.sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta)
+
+    def asperity_sweep(self, gamma, h, settings, *, n_delta=None, delta=None):
+        if delta is None:
+            delta = delta_grid(settings, n_delta, dtype=gamma.dtype).to(gamma.device)
+        sw = curves.sweep(gamma, h, settings, delta=delta)
+        gap = delta[None, :, None] - anchor(h)[:, None, :]
+        return sw, area(gamma[:, None, :], gap, settings.radius) / settings.nominal_area
+
+
+@dataclass(frozen=True, repr=True)
+class Interacting(ForwardModel):
+    """The asperities with their elastic interaction through the periodic lattice.
+
+    curvature: also the neighbours' curvature term (see ``physics.interaction``); off by
+    default (the tip shift only). iterations: Newton sweeps of the self-consistent solve.
+    """
+
+    curvature: bool = CURVATURE
+    iterations: int = ITERATIONS
+
+    name = "interacting"
+    placed = True
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.curvature, bool):
+            raise MetainterfaceError(f"curvature must be True or False, got {self.curvature!r}")
+        if isinstance(self.iterations, bool) or not (
+            isinstance(self.iterations, int) and 1 <= self.iterations <= 100
+        ):
+            raise MetainterfaceError(
+                f"iterations must be a whole number in [1, 100], got {self.iterations!r}"
+            )
+
+    def _opts(self) -> dict:
+        return {"curvature": self.curvature, "iterations": self.iterations}
+
+    def sweep(self, gamma, h, settings, *, smooth=None, n_delta=None, delta=None) -> Sweep:
+        return sweep_interacting(
+            gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta, **self._opts()
+        )
+
+    def load_area(self, gamma, h, settings, *, smooth=None, n_delta=None, delta=None) -> Sweep:
+        d, p, a = load_area_interacting(
+            gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta, **self._opts()
+        )
+        return Sweep(delta=d, p_star=p, alpha=a, stiffness=torch.full_like(p, float("nan")))
+
+    def asperity_sweep(self, gamma, h, settings, *, n_delta=None, delta=None):
+        return asperity_sweep_interacting(
+            gamma, h, settings, n_delta=n_delta, delta=delta, **self._opts()
+        )
+
+
+#: The registry: name -> model. ``design``, ``curve``, ``validate`` and the CLI read it.
+MODELS: dict[str, ForwardModel] = {"independent": Independent(), "interacting": Interacting()}
+#: The model used where none is named.
+DEFAULT_MODEL = "independent"
+
+
+def register_model(model: ForwardModel) -> ForwardModel:
+    """Add ``model`` to the registry under ``model.name`` (replacing one of that name)."""
+    if not isinstance(model, ForwardModel) or not model.name:
+        raise MetainterfaceError("register_model takes a ForwardModel instance with a name")
+    MODELS[model.name] = model
+    return model
+
+
+def get_model(model: str | ForwardModel | None = None) -> ForwardModel:
+    """The model for a name or an instance (None: the default, ``independent``)."""
+    if model is None:
+        return MODELS[DEFAULT_MODEL]
+    if isinstance(model, ForwardModel):
+        return model
+    if isinstance(model, str) and model in MODELS:
+        return MODELS[model]
+    raise MetainterfaceError(
+        f"model must be one of {', '.join(MODELS)} or a ForwardModel, got {model!r}"
+    )
+
+
+def models_at(design: Design, p_star: np.ndarray) -> dict[str, np.ndarray]:
+    """alpha (K,) of one design at the loads ``p_star`` (K,) under every registered model."""
+    gamma, h = design.tensors(torch.float64)
+    loads = torch.as_tensor(np.asarray(p_star, dtype=np.float64))[None]
+    with torch.no_grad():
+        return {
+            name: m.alpha_at_loads(gamma, h, design.settings, loads)[0].numpy()
+            for name, m in MODELS.items()
+        }
