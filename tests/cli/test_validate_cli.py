@@ -79,7 +79,7 @@ def test_malformed_design_file(tmp_path, capsys):
 def test_missing_tamaas_says_how_to_install(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "tamaas", None)  # import tamaas -> ImportError
     assert main(["validate", EXAMPLE, "--out", str(tmp_path / "run")]) == 2
-    assert "pip install tamaas" in one_line_error(capsys)
+    assert "pip install 'metainterface[bem]'" in one_line_error(capsys)
 
 
 def test_validate_physics_reports_both(tmp_path, capsys):

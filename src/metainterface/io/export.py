@@ -154,6 +154,19 @@ def height_patch(
     )
 
 
+def _require(module: str, what: str) -> Any:
+    """Import an optional export library, or a one-line error with the install command."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise MetainterfaceError(
+            f"{what} export needs {module}, which is not installed: run "
+            "`pip install 'metainterface[export]'`"
+        ) from None
+
+
 def patch_mesh(patch: Patch, base: float) -> Any:
     """A watertight trimesh.Trimesh of the patch on a base plate, in millimetres.
 
@@ -161,8 +174,7 @@ def patch_mesh(patch: Patch, base: float) -> Any:
     z = 0, the grid spans [0, nx L R] x [0, ny L R]; the last row and column close the
     period (they repeat the first). Faces are wound outwards.
     """
-    import trimesh
-
+    trimesh = _require("trimesh", "STL")
     if not (math.isfinite(base) and base > 0):
         raise MetainterfaceError(f"--base must be > 0 for an STL, got {base!r}")
     ny, nx = patch.heights.shape  # cells of the surface grid; nodes are one more each way
@@ -224,6 +236,7 @@ def _quantise(heights: np.ndarray) -> tuple[np.ndarray, dict[str, float]]:
 
 
 def _png_bytes(levels: np.ndarray, spacing: float, note: str) -> bytes:
+    _require("PIL", "PNG")
     from PIL import Image, PngImagePlugin
 
     info = PngImagePlugin.PngInfo()
@@ -235,8 +248,7 @@ def _png_bytes(levels: np.ndarray, spacing: float, note: str) -> bytes:
 
 
 def _tiff_bytes(levels: np.ndarray, spacing: float, note: str) -> bytes:
-    import tifffile
-
+    tifffile = _require("tifffile", "TIFF")
     per_cm = 0.01 / spacing
     buf = io.BytesIO()
     tifffile.imwrite(

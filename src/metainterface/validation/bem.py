@@ -31,7 +31,7 @@ TOLERANCE = 1e-11
 #: Iteration cap per solve (Tamaas's default). 768^2 cells converge in ~110 iterations.
 MAX_ITER = 1000
 
-INSTALL_HINT = "pip install tamaas"
+INSTALL_HINT = "pip install 'metainterface[bem]'"
 
 
 def require_tamaas() -> ModuleType:
