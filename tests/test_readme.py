@@ -20,3 +20,15 @@ def test_ci_runs_the_readme_test_command():
 def test_readme_install_takes_the_cpu_constraints():
     for cmd in _readme_commands():
         assert "-c constraints-cpu.txt" in cmd
+
+
+def test_the_readme_python_example_runs_as_written(tmp_path, monkeypatch):
+    text = (ROOT / "README.md").read_text()
+    code = text.split("```python\n")[1].split("\n```")[0]
+    monkeypatch.chdir(tmp_path)  # it writes bilinear.json and patch.stl where it runs
+    namespace: dict = {}
+    exec(compile(code, "README.md", "exec"), namespace)
+    assert namespace["r"].error < 0.01
+    assert namespace["v"].alpha_bem.shape == (4,)
+    assert (tmp_path / "patch.stl").stat().st_size > 0
+    assert (tmp_path / "patch.stl.json").is_file()

@@ -14,6 +14,7 @@ from metainterface import _checks
 from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline
+from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
 from metainterface.physical.dimensions import physical_block
 from metainterface.physical.units import (
@@ -61,7 +62,9 @@ def _limit(max_pressure: float | str | None, modulus: str | float | None) -> flo
     if max_pressure is None:
         return None
     e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
-    return parse_pressure_limit(max_pressure, e_star=e_star, option="max_pressure")
+    return parse_pressure_limit(
+        max_pressure, e_star=e_star, option="max_pressure", modulus_option="modulus"
+    )
 
 
 def design(
@@ -83,6 +86,7 @@ def design(
     total_force: str | float | None = None,
     area: str | float | None = None,
     meta: dict[str, Any] | None = None,
+    refine_settings: RefineSettings | None = None,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target.
 
@@ -126,6 +130,9 @@ def design(
         design.json, and the number of cells for a total force ('10N') or an area ('4cm2').
     meta : dict
         Extra JSON-ready keys stored in each design.json (e.g. the command line).
+    refine_settings : RefineSettings
+        The refinement's stages, iterations and tolerances (default: the paper's 5 stages x
+        5 steps x 20 iterations, then the polish); fewer make a quicker, rougher design.
 
     Returns
     -------
@@ -140,6 +147,8 @@ def design(
     seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
     if settings is not None and not isinstance(settings, CellSettings):
         raise MetainterfaceError("settings must be a CellSettings")
+    if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
+        raise MetainterfaceError("refine_settings must be a RefineSettings")
     if not isinstance(refine, bool):
         raise MetainterfaceError(f"refine must be True or False, got {refine!r}")
     fm = get_model(model)
@@ -161,6 +170,7 @@ def design(
         seed=seed,
         extra_loss=extra_loss,
         model=fm,
+        refine_settings=refine_settings,
         hedge=hedge if method == "surrogate" else 0,
         fallback=fallback if method == "surrogate" else 0,
     )

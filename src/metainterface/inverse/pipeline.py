@@ -9,6 +9,7 @@ independent problems.
 from __future__ import annotations
 
 import copy
+import functools
 import os
 import time
 import warnings
@@ -173,7 +174,6 @@ def design(
     method, notes = _usable_method(method, settings, model_path)
     if notes:
         warnings.warn(notes[0], stacklevel=2)
-        common["starts"] = max(starts, fallback)
         hedge = fallback = 0
     results = _design(targets, method, hedge=hedge, **common)
     if notes:
@@ -311,7 +311,22 @@ def reachable_envelope(
 
     From a fixed family of designs: uniform cells over a gamma grid at h = 0, single active
     asperities, and ``samples`` random cells; P*_reach is the largest pressure any reaches.
+    The envelope is computed once per cell on a fine pressure grid and interpolated (lo = inf,
+    hi = -inf beyond P*_reach).
     """
+    grid, lo, hi, reach = _envelope(settings, samples, seed)
+    p = np.asarray(p_star, dtype=np.float64)
+    inside = p <= reach
+    lo_q = np.where(inside, np.interp(p, grid, lo), np.inf)
+    hi_q = np.where(inside, np.interp(p, grid, hi), -np.inf)
+    return lo_q, hi_q, reach
+
+
+@functools.lru_cache(maxsize=8)
+def _envelope(
+    settings: CellSettings, samples: int, seed: int, points: int = 256
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The family's envelope on ``points`` pressures over [0, P*_reach]."""
     n = settings.n_asperities
     gammas = torch.linspace(settings.gamma_min, settings.gamma_max, 12, dtype=DTYPE)
     uniform = gammas[:, None].expand(-1, n)
@@ -320,13 +335,16 @@ def reachable_envelope(
     g_r, h_r = random_starts(samples, 1, settings, seed, FULL)
     gamma = torch.cat([uniform, uniform, g_r])
     h = torch.cat([torch.zeros(12, n, dtype=DTYPE), single_h, h_r])
-    p = torch.as_tensor(p_star, dtype=DTYPE)[None].expand(gamma.shape[0], -1)
     with torch.no_grad():
-        alpha, p_max = alpha_at(gamma, h, settings, p)
-    reached = p <= p_max[:, None]
+        p_max = alpha_at(gamma, h, settings, torch.zeros(gamma.shape[0], 1, dtype=DTYPE))[1]
+        reach = float(p_max.max())
+        # denser near 0, where every curve rises steeply (alpha ~ P*^(2/gamma))
+        grid = reach * torch.linspace(0.0, 1.0, points, dtype=DTYPE) ** 2
+        alpha, _ = alpha_at(gamma, h, settings, grid[None].expand(gamma.shape[0], -1))
+    reached = grid[None] <= p_max[:, None]
     lo = torch.where(reached, alpha, torch.inf).amin(0)
     hi = torch.where(reached, alpha, -torch.inf).amax(0)
-    return lo.numpy(), hi.numpy(), float(p_max.max())
+    return grid.numpy(), lo.numpy(), hi.numpy(), reach
 
 
 def reachability_warnings(

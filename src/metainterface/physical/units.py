@@ -120,7 +120,11 @@ def parse_force(value: str | float, *, option: str = "force") -> float:
 
 
 def parse_pressure_limit(
-    value: str | float, *, e_star: float | None = None, option: str = "--max-pressure"
+    value: str | float,
+    *,
+    e_star: float | None = None,
+    option: str = "--max-pressure",
+    modulus_option: str = "--modulus",
 ) -> float:
     """A contact-pressure limit as the dimensionless ratio p / E*.
 
@@ -136,14 +140,14 @@ def parse_pressure_limit(
         if not (math.isfinite(ratio) and 0 < ratio <= 1):
             raise MetainterfaceError(
                 f"{option} {text} read as p/E* must be in (0, 1]; give a stress with a unit "
-                f"(e.g. 50MPa) together with --modulus"
+                f"(e.g. 50MPa) together with {modulus_option}"
             )
         return ratio
     stress = parse_pressure(text, option=option)
     if e_star is None:
         raise MetainterfaceError(
-            f"{option} {text} is a stress: give --modulus (E*) too, or the limit as p/E*"
+            f"{option} {text} is a stress: give {modulus_option} (E*) too, or the limit as p/E*"
         )
     if not (math.isfinite(e_star) and e_star > 0):
-        raise MetainterfaceError(f"--modulus must be > 0, got {e_star}")
+        raise MetainterfaceError(f"{modulus_option} must be > 0, got {e_star}")
     return stress / e_star
