@@ -81,7 +81,7 @@ def hedge_starts(
     """(T, hedge, N) extra starts beside the zero-shot designs gamma0, h0 (T, N).
 
     The first half are jittered copies of the zero-shot design: the refinement of a
-    near-miss often ends in a neighbouring basin that is better (bilinear: 0.14 % -> 0.06 %).
+    near-miss often ends in a neighbouring basin that is better.
     The rest are the random starts of the multistart baseline (its first ones), for targets
     the surrogate reads wrong (the linear law). Seeded; the same for every target."""
     t, n = gamma0.shape
@@ -107,8 +107,8 @@ def predict(
 
     One target at a time, in float64. Matrix products round differently with the batch size
     (by ~1e-16 in float64), and the refinement's stopping decisions can carry even that into
-    another local optimum (seen: 0.008 % vs 0.06 % on ``saturating``). Row by row, a target
-    gets the same design alone or in any batch; the network costs ~0.1 ms a target."""
+    another local optimum. Row by row, a target gets the same design alone or in any batch,
+    and the network is cheap next to the refinement."""
     net = copy.deepcopy(model).to(DTYPE).eval()
     with torch.no_grad():
         rows = [

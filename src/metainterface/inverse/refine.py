@@ -42,23 +42,21 @@ class RefineSettings:
     kappa_end: float = 1e5
     undershoot_weight: float = 0.1
     grid_points: int = 128
-    # A row leaves a stage once 5 iterations lower its loss by less than this fraction
-    # (1 %): 3-6x fewer evaluations, the same errors within 0.1 % on the built-in targets
-    # and on random realisable ones (benchmarks/bench_design.py).
+    # A row leaves a stage once 5 iterations lower its loss by less than this fraction:
+    # far fewer evaluations at the same final errors (benchmarks/bench_design.py).
     tol_stall: float = 0.01
     # then the winning row of each target gets up to this many more iterations (``polish``),
     # on the exact contact law (``polish_exact``) or at kappa_end, stopping only once 5
-    # iterations lower the loss by less than ``polish_tol_stall`` (0.01 %) together: rows
-    # still converging run on, a row in a local minimum (the linear law's, at 5 %) stops
+    # iterations lower the loss by less than ``polish_tol_stall`` together: rows still
+    # converging run on, a row in a local minimum (the linear law's) stops
     polish_iterations: int = 100
     polish_tol_stall: float = 1e-4
     polish_exact: bool = True
     # The polish's method on the exact law: "levmar", Levenberg-Marquardt on the loss's
     # residuals (:func:`residuals`; their Jacobian costs one gradient), steps cut to
     # ``polish_max_step`` in the unbounded parameters; or "lbfgs", more iterations of the
-    # stages' method. On the built-in targets Levenberg-Marquardt reaches in ~40 evaluations
-    # what L-BFGS does not in 130 (bilinear 0.028 % -> ~0 %): the exact law's loss has kinks
-    # and curved valleys that Gauss-Newton steps follow and quasi-Newton pairs do not.
+    # stages' method. The exact law's loss has kinks and curved valleys that Gauss-Newton
+    # steps follow and quasi-Newton pairs do not (bench_design.py --polish compares them).
     polish_method: str = "levmar"
     polish_max_step: float = 0.3
     # the stages use the exact contact law instead of the softplus (set by ``polishing``)
@@ -68,12 +66,10 @@ class RefineSettings:
     # not a converged one
     tol_grad: float = 1e-7
     tol_change: float = 1e-10
-    # A row that meets its target to this relative curve error has met it and stops (the
-    # loss is the squared error where the curve covers the target's range). 1e-5 (0.001 %)
-    # is ~300x below the BEM's accuracy on these cells. Errors of this order are not a
-    # ranking of designs: the exact law's loss has kinks where asperities engage inside
-    # the target's range, line searches end at them, and where a refinement stops there
-    # moves with perturbations of the start as small as 1e-13.
+    # A row that meets its target to this relative curve error has met it and stops: far
+    # below the BEM's accuracy. Errors of this order rank nothing: the exact law's loss has
+    # kinks where asperities engage, and where a refinement stops there moves with the last
+    # bits of the start.
     tol_error: float = 1e-5
 
     def __post_init__(self) -> None:

@@ -44,34 +44,26 @@ spreading load j over its contact disc changes its field at tip i by a relative
 of the field changes the area only at second order; terms of order (a/p)^4 are dropped.
 
 Which terms (``curvature``). The tip shift w is the interaction that matters: it moves
-engagements, which is where the paper's model errs by up to 18 % (benchmarks/results/
-interaction.md). The curvature term b is the next one: for identical gamma = 4 asperities
-near Delta_max it lowers alpha at given P* by 1.2 %, 0.1-0.2 % for gamma <= 2, and near
-engagement it regularises a blunt asperity's contact (locally a sphere of radius 1/(2 b)).
-It is physically right, and with the BEM's contact edges placed to sub-pixel accuracy
-(``validation.bem.contact_area``) it shows at 768 x 768: over the upper half of 8 loads,
-the 20 random cells of benchmarks/results/interaction.md are within 0.09-0.47 % of Tamaas
-with the tip shift only and 0.07-0.19 % with b; the uniform gamma = 4 cell 1.20 % and
-0.08 %. But b makes the uniform gamma = 1.8 and 2 cells slightly worse (0.47 -> 0.53 %,
-0.27 -> 0.36 %), it costs ~30-50 % more (beyond 3x the paper's model), and without it
-identical asperities give exactly the paper's model. So the default is the tip shift only
-(``CURVATURE``); ``curvature=True`` adds b, for blunt-dominated designs, finer checks or
-the manufactured part itself. With b, P* at Delta_max can be ~2 % lower than in the
-paper's model; either way the models reach different P* at Delta_max, so compare them at
-equal P* (``forward.alpha_at_loads``).
+engagements, where the paper's model errs most. The curvature term b is the next one: it
+lowers alpha at given P* for blunt asperities near Delta_max and regularises a blunt
+asperity's contact near engagement (locally a sphere of radius 1/(2 b)). It is physically
+right and shows in BEM checks of blunt cells, but it makes cells of Hertzian asperities
+slightly worse, it costs more, and without it identical asperities give exactly the paper's
+model. So the default is the tip shift only (``CURVATURE``); ``curvature=True`` adds b, for
+blunt-dominated designs, finer checks or the manufactured part itself. The models reach
+different P* at Delta_max, so compare them at equal P* (``ForwardModel.alpha_at_loads``).
+The measured errors of both variants against Tamaas are in benchmarks/results/interaction.md.
 
-The solve. A fixed number of Newton sweeps in d (``ITERATIONS``), each taking the
-self-image term and the asperity's own curvature term implicitly (diagonal Newton) and the
-neighbours explicitly; the coupling left is |K_ij| dF_j/ddelta_j <= ~0.04 per pair. On 256
-random cells, alpha at equal P* (upper half of the loads) is within 1.7e-3 of the converged
-solution after two sweeps (median 8e-5) and 7e-5 after three, both below the BEM's own
-error (~0.3 %). Two is the default: each sweep is a power-law evaluation of the whole
-state, and two keep the model within 3x the cost of the paper's. The sweeps are unrolled, so
-autograd differentiates through them. S* = dP*/dalpha uses the tangent d/dDelta of the
-equations above at the final state (with the engagement factor of the last sweep), by the
-same Jacobi scheme. Inside, tensors are laid
-out (N, B, K) (N asperities, B designs, K Delta samples): elementwise passes run along K,
-the kernels are one matrix product per sweep and the sums over asperities add contiguous
+The solve. A fixed number of Newton sweeps in d (``ITERATIONS``), each taking the self-image
+term and the asperity's own curvature term implicitly (diagonal Newton) and the neighbours
+explicitly; the coupling left is |K_ij| dF_j/ddelta_j <= ~0.04 per pair, so two sweeps leave
+alpha well below the BEM's own error from the converged solution
+(benchmarks/bench_interaction.py), at a cost that stays a small multiple of the paper's
+model. The sweeps are unrolled, so autograd differentiates through them. S* = dP*/dalpha
+uses the tangent d/dDelta of the equations above at the final state (with the engagement
+factor of the last sweep), by the same Jacobi scheme. Inside, tensors are laid out (N, B, K)
+(N asperities, B designs, K Delta samples): elementwise passes run along K, the kernels are
+one matrix product per sweep and the sums over asperities add contiguous
 slabs.
 """
 
@@ -93,8 +85,8 @@ from metainterface.physics.sneddon import engagement, indentation, log_kc
 #: Newton sweeps of the forward solve (and Jacobi sweeps of its tangent).
 ITERATIONS = 2
 #: Whether the neighbours' curvature term is in the model by default: no (see the docstring,
-#: "Which terms"): it helps blunt cells, costs beyond 3x the paper's model, and makes
-#: identical asperities differ from it.
+#: "Which terms"): it helps blunt cells, costs more, and makes identical asperities differ
+#: from the paper's model.
 CURVATURE = False
 
 # Ewald splitting on the unit cell: beta = sqrt(pi) balances the two sums; 6 shells of

@@ -5,13 +5,14 @@ Input: the flattened normalised curve (alpha_hat, S_hat) on n_steps pressures pl
 gamma_i = gamma_min + (gamma_max - gamma_min) y_i and to heights through gaps
 g_1 = 0, g_j = y_j G, h = cumsum(g), sorted by construction.
 
-The gap scale G is the one deliberate departure from the paper. The paper's G = 2 Delta_max /
-(N - 1) (0.25 Delta_max for N = 9) caps h_k at (k - 1) G, so a cell whose second asperity sits
-beyond Delta_max cannot be expressed at all. Every test design of the truncated, stratified and
-bimodal categories has a gap above that cap; clipping their gaps to it changes their curves by
-a median 63 %, 49 % and 19 %, and a network with the paper's G stalls at 9-14 % median error
-there. G = 1.1 Delta_max reaches every design of the six categories (a gap of Delta_max already
-switches all later asperities off) at the price of a coarser output scale for small gaps.
+The gap scale G is the one deliberate departure from the paper. The paper's G = 2 Delta_max
+/ (N - 1) (0.25 Delta_max for N = 9) caps h_k at (k - 1) G, so a cell whose second asperity
+sits beyond Delta_max cannot be expressed at all. Every test design of the truncated,
+stratified and bimodal categories has a gap above that cap
+(benchmarks/surrogate_diagnostics.py measures what clipping does to their curves;
+MODEL_CARD.md what it does to the network). G = 1.1 Delta_max reaches every design of the
+six categories (a gap of Delta_max already switches all later asperities off) at the price
+of a coarser output scale for small gaps.
 ``max_gap`` sets G in units of Delta_max; None gives the paper's value.
 """
 
@@ -38,8 +39,8 @@ def check_max_gap(max_gap: float | None) -> float | None:
 class Dropout(nn.Module):
     """Inverted dropout (as nn.Dropout) whose mask comes from 16-bit random numbers.
 
-    nn.Dropout draws one Bernoulli variate per element, which took ~15 % of a training step
-    here; one 64-bit draw gives four 16-bit uniforms, four times fewer calls to the generator.
+    nn.Dropout draws one Bernoulli variate per element, a visible share of a training step;
+    one 64-bit draw gives four 16-bit uniforms, four times fewer calls to the generator.
     The drop probability is rounded to a multiple of 2^-16 (0.1 -> 0.100006).
     """
 

@@ -51,14 +51,12 @@ class TrainConfig:
     max_gap: the network's height-gap scale in units of Delta_max (None: the paper's
     2 / (N - 1); see :mod:`metainterface.surrogate.model`).
     w_shape, w_grad, w_mag: the weights of the composite loss, also used for the validation
-    loss that early stopping watches. The paper's are 10, 1, 10. With them the magnitude
-    term is about 1 % of the loss, and the errors of P*_max and alpha_max (~15 % and ~10 %)
-    dominate the zero-shot alpha(P*) error. w_mag = 1000 brings both under 2 % at no cost
-    in shape (MODEL_CARD.md has the comparison).
+    loss that early stopping watches. The paper's are 10, 1, 10; with them the magnitude term
+    is a small part of the loss and the errors of P*_max and alpha_max dominate the zero-shot
+    error, which w_mag = 1000 removes (MODEL_CARD.md has the comparison).
     w_curve: the weight of the relative curve error, the figure `evaluate` reports (not in
     the paper: 0 there). It trains shape and magnitude together where they matter for
-    alpha(P*); at 300 it took the 80-epoch medians of the two hardest categories from
-    ~4.2 % to ~2.4 % (MODEL_CARD.md).
+    alpha(P*) (MODEL_CARD.md has the ablation).
     """
 
     epochs: int = 500

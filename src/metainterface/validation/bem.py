@@ -99,21 +99,17 @@ def contact_area(
     fractions of the cell.
 
     Counting grid points in contact puts every contact edge half-way between the last point
-    in contact and the first one out, which reads alpha high by up to a few % at 768 x 768
-    (an edge's offset of ~0.5 grid step on a contact radius of 20-60 steps; worse and noisy
-    for the first contacts). Near the edge of a smooth contact the pressure falls as the
-    square root of the distance to the edge, so p^2 is linear in it: along each grid line,
-    p^2 at an edge point and at its neighbour inside extrapolate to zero at the edge, a
-    fraction t = p_e^2 / (p_in^2 - p_e^2) of a step beyond the edge point (clipped to
-    [0, 1]; 0.5, the count's value, where a run is one point long or p does not rise
-    inwards). The area is the count plus sum (t - 1/2) over the edge points of the rows,
-    averaged with the same along the columns. Against Sneddon's closed forms for single
-    power-law asperities (gamma 1.8-4) at 256^2 the count reads +1.0 to +3.5 % for contact
-    radii of 10-30 steps, this +0.1 to +2.5 %, and within 0.7 % from 18 steps on
-    (benchmarks/bench_contact_area.py; bounds in tests/validation/test_bem.py). It still
-    reads small contacts high: on grid lines that graze an edge, p^2 is not linear over a
-    step.
-    """
+    in contact and the first one out, which reads alpha high (an edge's offset of ~0.5 grid
+    step on the contact radius; worse and noisy for the first contacts). Near the edge of a
+    smooth contact the pressure falls as the square root of the distance to the edge, so p^2
+    is linear in it: along each grid line, p^2 at an edge point and at its neighbour inside
+    extrapolate to zero at the edge, a fraction t = p_e^2 / (p_in^2 - p_e^2) of a step
+    beyond the edge point (clipped to [0, 1]; 0.5, the count's value, where a run is one
+    point long or p does not rise inwards). The area is the count plus sum (t - 1/2) over
+    the edge points of the rows, averaged with the same along the columns. Its accuracy
+    against Sneddon's closed forms is measured by benchmarks/bench_contact_area.py (bounds
+    in tests/validation/test_bem.py). It still reads small contacts high: on grid lines that
+    graze an edge, p^2 is not linear over a step."""
     p = np.asarray(pressure, dtype=np.float64)
     owner = np.asarray(owner).ravel()
     m = p.shape[0]
