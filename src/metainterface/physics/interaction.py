@@ -63,8 +63,7 @@ model. The sweeps are unrolled, so autograd differentiates through them. S* = dP
 uses the tangent d/dDelta of the equations above at the final state (with the engagement
 factor of the last sweep), by the same Jacobi scheme. Inside, tensors are laid out (N, B, K)
 (N asperities, B designs, K Delta samples): elementwise passes run along K, the kernels are
-one matrix product per sweep and the sums over asperities add contiguous
-slabs.
+one matrix product per sweep and the sums over asperities add contiguous slabs.
 """
 
 from __future__ import annotations
