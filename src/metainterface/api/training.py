@@ -9,7 +9,7 @@ from typing import Any
 from metainterface import _checks
 from metainterface.data import generate_dataset as _generate
 from metainterface.data import load_dataset
-from metainterface.data.dataset import GenerationReport
+from metainterface.data.dataset import DEFAULT_CHUNK, GenerationReport
 from metainterface.physics.cell import CellSettings
 from metainterface.surrogate.checkpoint import default_model_path, load_model
 from metainterface.surrogate.data import split_of
@@ -28,13 +28,16 @@ def generate_dataset(
     seed: int = 0,
     settings: CellSettings | None = None,
     progress: bool = True,
+    chunk: int = DEFAULT_CHUNK,
 ) -> GenerationReport:
     """Generate a training dataset: ``samples`` designs of the paper's six topography
     categories with their exact normalised curves, split 80/10/10, written atomically to
-    ``out`` (.npz). The same (samples, seed, settings) give the same arrays."""
+    ``out`` (.npz). The same (samples, seed, settings) give the same arrays; ``chunk``
+    (samples computed together) changes memory, not results."""
     samples = _checks.whole("samples", samples, low=1, high=MAX_SAMPLES)
     seed = _checks.whole("seed", seed, low=0, high=2**63 - 1)
-    return _generate(samples, seed, settings or CellSettings(), out, progress=progress)
+    chunk = _checks.whole("chunk", chunk, low=1, high=1_000_000)
+    return _generate(samples, seed, settings or CellSettings(), out, progress=progress, chunk=chunk)
 
 
 def train_surrogate(

@@ -60,9 +60,9 @@ def _float(option: str, text: str) -> float:
 
 
 def run(args: argparse.Namespace) -> int:
-    from metainterface.data import CATEGORIES, FIGURE_ORDER, generate_dataset
+    import metainterface as mi
+    from metainterface.data import CATEGORIES, FIGURE_ORDER
     from metainterface.data.dataset import DEFAULT_CHUNK
-    from metainterface.physics import CellSettings
 
     samples = _int("--samples", args.samples)
     if samples <= 0:
@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
     chunk = DEFAULT_CHUNK if args.chunk is None else _int("--chunk", args.chunk)
     if chunk <= 0:
         raise MetainterfaceError(f"--chunk must be > 0, got {chunk}")
-    settings = CellSettings(
+    settings = mi.CellSettings(
         n_asperities=_int("--n-asperities", args.n_asperities),
         delta_max=_float("--delta-max", args.delta_max),
         gamma_min=_float("--gamma-min", args.gamma_min),
@@ -85,8 +85,8 @@ def run(args: argparse.Namespace) -> int:
             f"use one of {', '.join(_FIGURE_SUFFIXES)}"
         )
 
-    report = generate_dataset(
-        samples, seed, settings, args.out, progress=not args.quiet, chunk=chunk
+    report = mi.generate_dataset(
+        samples, args.out, seed=seed, settings=settings, progress=not args.quiet, chunk=chunk
     )
     if args.plot:
         from metainterface.plots import plot_dataset_examples, save_figure

@@ -33,7 +33,7 @@ DEFAULT_LOADS = 20
 AREA_ESTIMATE = "subpixel-p2"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ValidationResult:
     """BEM against model for one design, at K loads on an M x M grid.
 
@@ -69,6 +69,13 @@ class ValidationResult:
     def rel_err(self) -> np.ndarray:
         """(K,) alpha_bem / alpha_model - 1."""
         return self.alpha_bem / self.alpha_model - 1.0
+
+    def __repr__(self) -> str:
+        return (
+            f"ValidationResult({self.name!r}, {len(self.p_star)} loads on {self.grid}x{self.grid}, "
+            f"model {self.model.label}: max |rel_err| {100 * self.max_rel_err_upper:.3g} % "
+            f"over the upper half, {100 * self.max_rel_err:.3g} % over all loads)"
+        )
 
     @functools.cached_property
     def alpha_by_model(self) -> dict[str, np.ndarray]:
