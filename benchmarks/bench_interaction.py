@@ -31,10 +31,10 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from metainterface.physics.forward import alpha_at, alpha_at_loads
 
 from metainterface.physics import CellSettings, Design, interp, sweep
 from metainterface.physics.interaction import load_area_interacting, sweep_interacting
+from metainterface.physics.models import Independent, Interacting
 from metainterface.runtime import tune_allocator
 
 RESULTS = Path(__file__).parent / "results"
@@ -89,7 +89,7 @@ def with_curvature(g, h, settings, loads):
 
 
 def alpha_at_curvature(g, h, settings, p):
-    """``forward.alpha_at(..., physics="interacting")`` with the curvature term."""
+    """``Interacting().alpha_at`` with the curvature term."""
     _, p_sw, alpha = load_area_interacting(g, h, settings, curvature=True)
     zero = torch.zeros_like(p_sw[:, :1])
     p_sw = torch.cat([zero, p_sw], dim=-1)
@@ -124,8 +124,8 @@ def accuracy(args, settings) -> list[str]:
         a_bem = np.array(e["alpha_bem"])
         # both models evaluated the same way, at the BEM's loads (past Delta_max if needed)
         a_ind, a_int = (
-            alpha_at_loads(gt, ht, settings, loads, physics=ph, n_delta=8193)[0].numpy()
-            for ph in ("independent", "interacting")
+            m.alpha_at_loads(gt, ht, settings, loads, n_delta=8193)[0].numpy()
+            for m in (Independent(), Interacting())
         )
         a_cur = with_curvature(gt, ht, settings, loads)[0].numpy()
         up = slice(N_LOADS // 2, None)
@@ -208,7 +208,7 @@ def convergence(settings: CellSettings, jobs: int) -> list[str]:
         p_max = float(sweep(gt, ht, settings).p_star[0, -1])
         loads = p_max * np.arange(5, 9) / N_LOADS
         lt = torch.tensor(loads)[None]
-        a_ind = alpha_at_loads(gt, ht, settings, lt, n_delta=8193)[0].numpy()
+        a_ind = Independent().alpha_at_loads(gt, ht, settings, lt, n_delta=8193)[0].numpy()
         a_cur = with_curvature(gt, ht, settings, lt)[0].numpy()
         solved = {m: plan_validation(design, m, loads).solve(jobs) for m in GRIDS}
         for label, a, area in (
@@ -247,8 +247,8 @@ def timing(settings: CellSettings, threads: int) -> list[str]:
             functools.partial(sweep_interacting, curvature=True),
         ),
         "alpha_at": (
-            functools.partial(alpha_at, physics="independent"),
-            functools.partial(alpha_at, physics="interacting"),
+            Independent().alpha_at,
+            Interacting().alpha_at,
             alpha_at_curvature,
         ),
     }

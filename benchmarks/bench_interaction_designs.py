@@ -39,18 +39,18 @@ PHYSICS = ("independent", "interacting")
 N_LOADS = 8
 
 
-def run_case(target_name: str, physics: str, grid: int, jobs: int) -> dict:
+def run_case(target_name: str, model: str, grid: int, jobs: int) -> dict:
     """Design for one target with one model, then its BEM check; a JSON-ready record."""
     target = builtin_target(target_name)
     t0 = time.perf_counter()
-    (res,) = design([target], "surrogate", physics=physics, hedge=8, fallback=50)
+    (res,) = design([target], "surrogate", model=model, hedge=8, fallback=50)
     design_seconds = time.perf_counter() - t0
     extras = {"target": {"p_star": target.p_star.tolist(), "alpha": target.alpha.tolist()}}
     cell = Design(gamma=res.gamma, h=res.h, settings=CellSettings(), extras=extras)
-    probe = plan_validation(cell, grid, 1, physics=physics)  # the design's reach
+    probe = plan_validation(cell, grid, 1, model=model)  # the design's reach
     top = min(target.p_star_max, float(probe.loads[-1]))
     plan = plan_validation(
-        cell, grid, top * np.arange(1, N_LOADS + 1) / N_LOADS, physics=physics, name=target_name
+        cell, grid, top * np.arange(1, N_LOADS + 1) / N_LOADS, model=model, name=target_name
     )
     t1 = time.perf_counter()
     result = plan.solve(jobs)
@@ -58,7 +58,7 @@ def run_case(target_name: str, physics: str, grid: int, jobs: int) -> dict:
     pixel_error = result.target_error(result.alpha_bem_pixels)
     return {
         "target": target_name,
-        "physics": physics,
+        "physics": model,
         "gamma": res.gamma.tolist(),
         "h": res.h.tolist(),
         "design_error": res.error,

@@ -14,7 +14,6 @@ from importlib.resources import files
 
 import numpy as np
 
-from metainterface.io import load_design
 from metainterface.physics import Design
 from metainterface.runtime import tune_allocator
 from metainterface.validation import available_cpus, plan_validation
@@ -46,7 +45,7 @@ def run(name: str, design: Design, grid: int, loads: int, jobs: int, target: flo
 
 def scaling(jobs: int) -> None:
     """Seconds per solve against grid size (example design, 4 loads), and jobs at 768."""
-    example = load_design(files("metainterface") / "examples" / "example_design.json")
+    example = Design.load(files("metainterface") / "examples" / "example_design.json")
     for grid, j in ((192, 1), (384, 1), (768, 1), (768, jobs)):
         t0 = time.perf_counter()
         res = plan_validation(example, grid, 4).solve(j)
@@ -67,7 +66,7 @@ def main() -> None:
     if args.only != "large":
         run("small", SMALL, 256, 8, args.jobs, 3)
     if args.only != "small":
-        example = load_design(files("metainterface") / "examples" / "example_design.json")
+        example = Design.load(files("metainterface") / "examples" / "example_design.json")
         run("paper", example, 768, 20, args.jobs, 60)
     if args.scaling:
         scaling(args.jobs)
