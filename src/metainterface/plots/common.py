@@ -29,6 +29,28 @@ def new_figure(width: float = 9.0, height: float = 3.6) -> Figure:
     return Figure(figsize=(width, height), layout="constrained")
 
 
+def panel_grid(
+    panels: int,
+    width: float,
+    *,
+    min_panel: float = 2.8,
+    max_cols: int | None = None,
+    aspect: float = 0.8,
+) -> tuple[Figure, list[Axes]]:
+    """A figure of ``width`` inches with ``panels`` axes, as many per row as fit at least
+    ``min_panel`` inches each (at most ``max_cols``): a narrow figure stacks its panels
+    rather than squeezing their labels together. aspect: panel height / panel width."""
+    if not (math.isfinite(width) and width > 0):
+        raise MetainterfaceError(f"width must be a number of inches > 0, got {width!r}")
+    cols = max(1, min(panels, max_cols or panels, int(width // min_panel)))
+    rows = -(-panels // cols)
+    fig = new_figure(width, rows * width / cols * aspect + 0.3)
+    axes = list(fig.subplots(rows, cols, squeeze=False).ravel())
+    for ax in axes[panels:]:
+        ax.remove()
+    return fig, axes[:panels]
+
+
 def percent(x: float) -> str:
     """A relative error in per cent with significant digits: '9.7e-06 %', '2.5 %'."""
     return f"{100 * x:.2g} %" if abs(100 * x) < 1 else f"{100 * x:.3g} %"
@@ -56,7 +78,7 @@ def tidy_axis(ax: Axes, *, x: bool = True, y: bool = True, bins: int = 5) -> Non
             continue
         axis.set_major_locator(MaxNLocator(bins))
         top = max(abs(lim[0]), abs(lim[1]))
-        power = int(math.floor(math.log10(top))) if top > 0 and math.isfinite(top) else 0
+        power = math.floor(math.log10(top)) if top > 0 and math.isfinite(top) else 0
         if -2 <= power <= 3:
             fmt = ScalarFormatter(useOffset=False)
             fmt.set_scientific(False)

@@ -10,7 +10,7 @@ import torch
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
-from metainterface.plots.common import new_figure, percent, short, tidy_axis
+from metainterface.plots.common import new_figure, panel_grid, percent, short, tidy_axis
 
 COLORS = {"surrogate": "C0", "multistart": "C2", "hertz": "C1"}
 #: Most target points drawn (a 100,000-row target draws as fast as a 100-row one).
@@ -95,9 +95,10 @@ def plot_design(result, curve, *, width: float | None = None) -> Figure:
         ax_m = fig.add_subplot(spots[3], sharex=ax_f)
     ax_p = fig.add_subplot(spots[-2])
     ax_c = fig.add_subplot(spots[-1])
-    fig.suptitle(
-        f"{short(t.name)}: {result.method} design, error {percent(result.error)}", fontsize=11
-    )
+    what = f"{result.method} design, error {percent(result.error)}"
+    name = short(t.name, max(16, min(40, int(5 * width))))
+    one_line = len(name) + len(what) + 2 <= min(60, 9 * width)
+    fig.suptitle(f"{name}: {what}" if one_line else f"{name}\n{what}", fontsize=11)
 
     keep = _every(t.p_star.size)
     p_top = 1.03 * max(t.p_star_max, float(curve.p_star[-1]))
@@ -146,9 +147,7 @@ def _friction_panels(ax_f, ax_m, target, curve, units: dict) -> None:
     style = "ko" if fn_t.size <= 60 else "k-"
     ax_f.plot(fn_t / scale, ff_t / scale, style, ms=4, label="friction law")
     ax_f.plot(fn_d / scale, ff_d / scale, "--", color="C0", label="design")
-    ax_f.set(
-        xlabel=f"normal force [{unit}]", ylabel=f"friction force [{unit}]", title="friction"
-    )
+    ax_f.set(xlabel=f"normal force [{unit}]", ylabel=f"friction force [{unit}]", title="friction")
     ax_f.set_xlim(0, 1.03 * max(fn_t.max(), fn_d.max()) / scale)
     ax_f.set_ylim(bottom=0)
     ax_f.legend(fontsize=8, loc="lower right")
@@ -265,13 +264,15 @@ def _height(h: float) -> str:
     return "0" if h < 5e-3 else f"{h:.2g}" if h < 10 else f"{h:.0f}"
 
 
-def plot_comparison(results: Sequence[Sequence], curves: Sequence[Sequence]) -> Figure:
+def plot_comparison(
+    results: Sequence[Sequence], curves: Sequence[Sequence], *, width: float | None = None
+) -> Figure:
     """Paper fig. 5: per target (column), the target and each method's design.
 
     results[i][j]: target i's DesignResult by method j; curves[i][j]: its curve (numpy
-    p_star, alpha)."""
-    fig = new_figure(4.2 * len(results), 3.6)
-    axes = np.atleast_1d(fig.subplots(1, len(results)))
+    p_star, alpha). width: inches (default 4.2 per target; narrower stacks them)."""
+    width = 4.2 * len(results) if width is None else width
+    fig, axes = panel_grid(len(results), width, min_panel=3.4, aspect=0.9)
     for ax, per_method, per_curve in zip(axes, results, curves, strict=True):
         t = per_method[0].target
         keep = _every(t.p_star.size)
