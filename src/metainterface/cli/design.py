@@ -158,6 +158,8 @@ def run(args: argparse.Namespace) -> int:
         full_target=args.full_target,
     )
     if args.compare:
+        if args.html:
+            raise mi.MetainterfaceError("--html draws one design per page; leave out --compare")
         by_method = mi.compare(targets, out=args.out, **options)
         results = [r for m in by_method.values() for r in m]
     else:  # one target: its files directly in --out; several: one folder each
@@ -168,6 +170,13 @@ def run(args: argparse.Namespace) -> int:
             **options,
         )
         results = made if isinstance(made, list) else [made]
+        if args.html:  # one page per design folder
+            from pathlib import Path
+
+            out = Path(args.out)
+            for r in results:
+                page = mi.view(out if len(results) == 1 else out / r.target.name)
+                print(f"{page}: interactive view")
     for r in results:
         for note in r.notes:
             print(f"warning: {note}", file=sys.stderr)

@@ -36,9 +36,10 @@ def target_stiffness(target) -> np.ndarray:
     return s
 
 
-def friction_units(target) -> dict | None:
-    """tau, E* [Pa] and the nominal area [m^2] of a target made from a friction law."""
-    law = target.meta.get("friction") if isinstance(target.meta, dict) else None
+def friction_units(meta: dict) -> dict | None:
+    """tau, E* [Pa], the nominal area [m^2] and the law's forces [N] of a target made from a
+    friction law, from its ``meta`` (or design.json's "target" entry); None otherwise."""
+    law = meta.get("friction") if isinstance(meta, dict) else None
     if not isinstance(law, dict):
         return None
     try:
@@ -72,7 +73,7 @@ def plot_design(result, curve, *, width: float | None = None) -> Figure:
     """
     width = 12.0 if width is None else float(width)
     t = result.target
-    units = friction_units(t)
+    units = friction_units(t.meta)
     # Panels per row from the width (about 2.8 inches each at least), so a narrow figure
     # stacks them instead of squeezing their labels together.
     panels = 6 if units else 4
