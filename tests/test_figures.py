@@ -124,7 +124,7 @@ def csv_result(tmp_path_factory):
     return mi.design(t, refine=False, hedge=0, fallback=0)
 
 
-@pytest.mark.parametrize("width", [SMALL, 7.0, 12.0, LARGE])
+@pytest.mark.parametrize("width", [SMALL, 9.0, LARGE])
 def test_design_figure_friction(friction_result, width):
     fig = friction_result.figure(width=width)
     check_figure(fig)
@@ -292,3 +292,18 @@ def test_the_check_sees_what_a_reader_would():
     ax.set(xlabel="x", ylabel="y", title="a title far too long for a figure this narrow")
     with pytest.raises(AssertionError, match="cut off"):
         check_figure(fig)
+
+
+@pytest.mark.parametrize("n", [4, 25])
+@pytest.mark.parametrize("width", [SMALL, LARGE])
+def test_design_figure_other_cells(csv_result, n, width):
+    """Cells of 2 x 2 and 5 x 5 asperities: labels sized to the lattice, none overlapping."""
+    import dataclasses
+
+    s = mi.CellSettings(n_asperities=n)
+    rng = np.random.default_rng(n)
+    d = mi.Design(
+        gamma=rng.uniform(1.9, 3.9, n), h=rng.uniform(0, 0.6, n) * s.delta_max, settings=s
+    )
+    fig = dataclasses.replace(csv_result, design=d).figure(width=width)
+    check_figure(fig)
