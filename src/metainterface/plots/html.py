@@ -119,9 +119,9 @@ def _curves_figure(curve, target, units: dict | None) -> Any:
         _friction_traces(fig, go, curve, units)
     fig.update_layout(
         height=430 * rows,
-        margin={"l": 60, "r": 20, "t": 50, "b": 50},
+        margin={"l": 60, "r": 10, "t": 40, "b": 50},
         hovermode="closest",
-        legend={"orientation": "h", "y": 1.08, "x": 0.0},
+        legend={"x": 1.02, "y": 1.0, "xanchor": "left"},  # right of the panels: no overlap
         template="plotly_white",
     )
     return fig
@@ -217,7 +217,7 @@ def _cell_figure(heights: np.ndarray, side: float, length_unit: str) -> Any:
         scene={
             "xaxis": {"title": {"text": f"x [{length_unit}]"}},
             "yaxis": {"title": {"text": f"y [{length_unit}]"}},
-            "zaxis": {"title": {"text": "z / Δmax"}, "nticks": 4},
+            "zaxis": {"title": {"text": "z / Δmax"}, "nticks": 3},
             "aspectmode": "manual",
             "aspectratio": {"x": 1, "y": 1, "z": 0.35},
         },
