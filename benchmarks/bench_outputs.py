@@ -36,7 +36,8 @@ def main() -> None:
         wall = time.perf_counter() - t0
         row = next(line for line in done.stdout.splitlines() if line.startswith("long"))
         print(f"target CSV: {args.rows} rows, {csv.stat().st_size / 1e6:.2f} MB")
-        print(f"wall {wall:.1f} s (load average before {load:.1f}); design step {row.split()[-1]} s")
+        step = row.split()[-1]
+        print(f"wall {wall:.1f} s (load average before {load:.1f}); design step {step} s")
         for f in sorted(out.iterdir()):
             print(f"  {f.name}: {f.stat().st_size / 1e3:.1f} kB")
 

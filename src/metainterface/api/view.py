@@ -40,6 +40,11 @@ def view(
         The page to write (default: ``view.html`` in the design folder; required for a
         result or a Design).
 
+    Returns
+    -------
+    Path
+        The page written (atomically).
+
     The page shows alpha(P*) and S*(P*) against the target with hover values (and, for a
     target made from a friction law, the friction force and coefficient against the normal
     force in newtons), the unit cell as a 3D surface, the parameters, and the folder's files
