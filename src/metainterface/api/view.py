@@ -119,9 +119,13 @@ def _collect(source: Any, path: str | os.PathLike[str] | None) -> dict[str, Any]
     heights, side, unit = _surface(design, record, float(h0.max()))
     files = _files(source, folder, path, record)
     error = record.get("relative_error")
+    named = record.get("model")
+    drawn = model.label
+    if isinstance(named, str) and named != drawn:  # a model this session has not registered
+        drawn = f"{drawn} (design.json names {named}, not registered here)"
     summary = [
         ("method", str(record.get("method", "given"))),
-        ("forward model", model.label),
+        ("forward model of the curves", drawn),
         *([("relative error", f"{100 * float(error):.3g} %")] if error is not None else []),
         ("asperities", f"{design.gamma.size} ({st.n_side} x {st.n_side})"),
         ("shape exponents γ", f"{design.gamma.min():.3f} to {design.gamma.max():.3f}"),

@@ -170,13 +170,6 @@ def run(args: argparse.Namespace) -> int:
             **options,
         )
         results = made if isinstance(made, list) else [made]
-        if args.html:  # one page per design folder
-            from pathlib import Path
-
-            out = Path(args.out)
-            for r in results:
-                page = mi.view(out if len(results) == 1 else out / r.target.name)
-                print(f"{page}: interactive view")
     for r in results:
         for note in r.notes:
             print(f"warning: {note}", file=sys.stderr)
@@ -189,6 +182,13 @@ def run(args: argparse.Namespace) -> int:
             f"{r.target.name:<{width}}{r.method:<12}{100 * r.initial_error:>9.3g} %"
             f"{100 * r.error:>9.3g} %{r.seconds:>9.2f}"
         )
+    if args.html:  # one page per design folder
+        from pathlib import Path
+
+        out = Path(args.out)
+        for r in results:
+            page = mi.view(out if len(results) == 1 else out / r.target.name)
+            print(f"{page}: interactive view, opens in a browser")
     print(f"written to {args.out}")
     return 0
 
