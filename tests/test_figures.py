@@ -307,3 +307,17 @@ def test_design_figure_other_cells(csv_result, n, width):
     )
     fig = dataclasses.replace(csv_result, design=d).figure(width=width)
     check_figure(fig)
+
+
+def test_plot_methods_draw_on_given_axes(csv_result):
+    """result.plot() and curve.plot(): the target and the design on one pressure range."""
+    from matplotlib.figure import Figure
+
+    for width in (SMALL, LARGE):
+        ax = Figure(figsize=(width, 0.75 * width), layout="constrained").add_subplot()
+        assert csv_result.plot(ax) is ax
+        assert ax.get_xlim()[1] >= csv_result.target.p_star_max
+        check_figure(ax.figure)
+        ax = Figure(figsize=(width, 0.75 * width), layout="constrained").add_subplot()
+        csv_result.curve().plot(ax)
+        check_figure(ax.figure)
