@@ -124,7 +124,7 @@ def csv_result(tmp_path_factory):
     return mi.design(t, refine=False, hedge=0, fallback=0)
 
 
-@pytest.mark.parametrize("width", [SMALL, 9.0, LARGE])
+@pytest.mark.parametrize("width", [SMALL, LARGE])
 def test_design_figure_friction(friction_result, width):
     fig = friction_result.figure(width=width)
     check_figure(fig)
@@ -189,7 +189,7 @@ def test_curve_figure(width):
     assert all(ax.get_xlim()[1] >= c.p_star_max for ax in fig.axes)
 
 
-@pytest.mark.parametrize("epochs", [1, 3, 120])
+@pytest.mark.parametrize("epochs", [1, 120])
 @pytest.mark.parametrize("width", [SMALL, LARGE])
 def test_training_figure(epochs, width):
     ep = np.arange(1, epochs + 1)
@@ -205,7 +205,7 @@ def test_training_figure(epochs, width):
     check_figure(fig)
     lines = [ln for ax in fig.axes for ln in ax.get_lines()]
     assert len(lines) == 5
-    if epochs <= 3:  # few epochs: every one is a visible point
+    if epochs == 1:  # one epoch: a visible point, not a line of length zero
         assert all(ln.get_marker() == "o" for ln in lines)
 
 
@@ -294,8 +294,7 @@ def test_the_check_sees_what_a_reader_would():
         check_figure(fig)
 
 
-@pytest.mark.parametrize("n", [4, 25])
-@pytest.mark.parametrize("width", [SMALL, LARGE])
+@pytest.mark.parametrize(("n", "width"), [(4, SMALL), (25, SMALL), (25, LARGE)])
 def test_design_figure_other_cells(csv_result, n, width):
     """Cells of 2 x 2 and 5 x 5 asperities: labels sized to the lattice, none overlapping."""
     import dataclasses
