@@ -103,3 +103,11 @@ def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, ca
     np.testing.assert_allclose(data["target"]["alpha"][-1], 0.06, rtol=1e-9)
     assert main([*args[:-4], "--modulus", "2mm"]) == 2  # a length is not a stress
     assert "modulus" in capsys.readouterr().err
+
+
+def test_compare_of_one_target_writes_into_out(tmp_path):
+    out = tmp_path / "cmp"
+    quick = ["--refine", "none", "--starts", "2", "--hedge", "0", "--fallback", "0"]
+    assert main(["design", "--target", "linear", "--compare", "--out", str(out), *quick]) == 0
+    assert {p.name for p in out.iterdir()} == {"surrogate", "multistart", "hertz", "compare.png"}
+    assert (out / "hertz" / "design.json").is_file()

@@ -251,9 +251,10 @@ def compare(
     """Design every target with all three methods (paper fig. 5): {method: [results]}.
 
     ``options`` are those of :func:`design`; with ``out``, each method's files go to
-    ``out/<target>/<method>/`` and the comparison figure to ``out/<target>/compare.png``.
+    ``out/<target>/<method>/`` and the comparison figure to ``out/<target>/compare.png``
+    (one target: ``out/<method>/`` and ``out/compare.png``).
     """
-    items, _ = _targets(targets)
+    items, single = _targets(targets)
     if "method" in options:
         raise MetainterfaceError("compare runs every method; leave method out")
     meta = options.pop("meta", None)
@@ -274,9 +275,10 @@ def compare(
         out = Path(out)
         for i, t in enumerate(items):
             per = [by_method[m][i] for m in pipeline.METHODS]
-            _save_all(per, [out / t.name / r.method for r in per], physical, meta, full_target)
+            base = out if single else out / t.name
+            _save_all(per, [base / r.method for r in per], physical, meta, full_target)
             fig = plot_comparison([per], [[r.curve() for r in per]])
-            save_figure(fig, out / t.name / "compare.png", command="compare")
+            save_figure(fig, base / "compare.png", command="compare")
     return by_method  # type: ignore[return-value]
 
 

@@ -160,7 +160,8 @@ def run(args: argparse.Namespace) -> int:
     if args.compare:
         if args.html:
             raise mi.MetainterfaceError("--html draws one design per page; leave out --compare")
-        by_method = mi.compare(targets, out=args.out, **options)
+        one = targets[0] if len(targets) == 1 else targets  # one target: files in --out
+        by_method = mi.compare(one, out=args.out, **options)
         results = [r for m in by_method.values() for r in m]
     else:  # one target: its files directly in --out; several: one folder each
         made = mi.design(
