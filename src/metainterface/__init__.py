@@ -23,6 +23,8 @@ Curves and forward models
     curve, Curve, ForwardModel, Independent, Interacting, MODELS, get_model, register_model
 Checking and making
     validate, validate_many, ValidationResult, write_result, export
+Looking at a design
+    view (an interactive, self-contained HTML page; the [view] extra), DesignResult.figure
 Your own design space
     generate_dataset, train_surrogate, TrainConfig, evaluate_surrogate
 Process settings
@@ -49,6 +51,7 @@ from metainterface.api import (
     train_surrogate,
     validate,
     validate_many,
+    view,
     write_result,
 )
 from metainterface.errors import MetainterfaceError
@@ -99,5 +102,6 @@ __all__ = [
     "tune_allocator",
     "validate",
     "validate_many",
+    "view",
     "write_result",
 ]

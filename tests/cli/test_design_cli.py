@@ -19,12 +19,41 @@ def test_design_cli_writes_outputs(tmp_path, capsys):
     )
     assert main(["design", "--target-csv", str(csv), "--out", str(out), "--refine", "none"]) == 0
     folder = out  # one target: its files directly in --out
-    for f in ("design.json", "target.csv", "curve.csv", "design.png"):
-        assert (folder / f).is_file(), f
+    assert {p.name for p in folder.iterdir()} == {"design.json", "curve.csv", "design.png"}
     data = json.loads((folder / "design.json").read_text())
     assert data["method"] == "surrogate" and 0 <= data["relative_error"] < 1
     assert "version" in data["provenance"]
+    assert data["target"]["points"] == len(t.p_star[::8])
     assert "surrogate" in capsys.readouterr().out
+
+
+def test_a_long_target_makes_a_small_design_file(tmp_path, capsys):
+    """The target is stored once, decimated in design.json; the whole of it goes to
+    target.csv only with --full-target, and no CSV's provenance line carries it."""
+    p = np.linspace(0.0, 0.002, 20_000)
+    csv = tmp_path / "measured_friction_of_batch_seventeen.csv"
+    alpha = 0.04 * (1 - np.exp(-p / 6e-4))
+    csv.write_text(
+        "p_star,alpha\n" + "".join(f"{a:.9g},{b:.9g}\n" for a, b in zip(p, alpha, strict=True))
+    )
+    out = tmp_path / "out"
+    args = ["design", "--target-csv", str(csv), "--out", str(out), "--refine", "none"]
+    assert main([*args, "--full-target"]) == 0
+    data = json.loads((out / "design.json").read_text())
+    assert (out / "design.json").stat().st_size < 40_000
+    assert data["target"]["points"] == 20_000 and len(data["target"]["p_star"]) <= 256
+    assert data["target"]["p_star"][-1] == pytest.approx(0.002)
+    assert data["target"]["sha256"].startswith("sha256:")
+    full = np.loadtxt(out / "target.csv", delimiter=",", skiprows=2)
+    assert full.shape == (20_000, 2)
+    for name in ("curve.csv", "target.csv"):
+        header = (out / name).read_text().splitlines()[0]
+        assert len(header) < 600 and header.startswith("# {")
+    table = capsys.readouterr().out.splitlines()
+    # the table fits the long name: every row's columns start where the header's do
+    head = table[0]
+    row = next(line for line in table if line.startswith(csv.stem))
+    assert row.index(" %") > head.index("zero-shot") and len(row) == len(head)
 
 
 def test_design_cli_bad_input(tmp_path, capsys):
@@ -74,3 +103,11 @@ def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, ca
     np.testing.assert_allclose(data["target"]["alpha"][-1], 0.06, rtol=1e-9)
     assert main([*args[:-4], "--modulus", "2mm"]) == 2  # a length is not a stress
     assert "modulus" in capsys.readouterr().err
+
+
+def test_compare_of_one_target_writes_into_out(tmp_path):
+    out = tmp_path / "cmp"
+    quick = ["--refine", "none", "--starts", "2", "--hedge", "0", "--fallback", "0"]
+    assert main(["design", "--target", "linear", "--compare", "--out", str(out), *quick]) == 0
+    assert {p.name for p in out.iterdir()} == {"surrogate", "multistart", "hertz", "compare.png"}
+    assert (out / "hertz" / "design.json").is_file()

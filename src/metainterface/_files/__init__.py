@@ -6,14 +6,21 @@ stream results without importing the format layer (``metainterface.io``) above i
 
 from metainterface._files.atomic import atomic_open, ensure_parent, write_bytes, write_text
 from metainterface._files.columns import read_columns, write_columns
-from metainterface._files.provenance import csv_header, provenance
+from metainterface._files.provenance import (
+    compact_provenance,
+    csv_header,
+    provenance,
+    short_hash,
+)
 
 __all__ = [
     "atomic_open",
+    "compact_provenance",
     "csv_header",
     "ensure_parent",
     "provenance",
     "read_columns",
+    "short_hash",
     "write_bytes",
     "write_columns",
     "write_text",

@@ -1,7 +1,16 @@
-"""What every output file records: the package version and the settings that made it."""
+"""What every output file records: the package version and the settings that made it.
+
+:func:`provenance` keeps the settings whole (a dataset rebuilds its cell from them).
+:func:`compact_provenance`, for the one-line records of CSV files and figures, keeps them
+small: a value whose JSON form is longer than ``MAX_INLINE`` characters (a whole design, a
+list of loads, a target) is recorded as its short sha256, so the line never grows with the
+inputs. Both carry ``inputs_sha256``, the hash of all the settings together, to tell at a
+glance whether two files were made from the same inputs.
+"""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import platform
 from datetime import UTC, datetime
@@ -9,9 +18,26 @@ from typing import Any
 
 import torch
 
+#: Longest JSON text of one setting kept as is; longer ones are replaced by their hash.
+MAX_INLINE = 200
+#: Hex digits of the short hashes (64 bits: collisions are no concern for a record).
+HASH_DIGITS = 16
+
+
+def short_hash(value: Any) -> str:
+    """'sha256:<16 hex>' of a JSON-ready value (keys sorted, so dict order does not matter)."""
+    text = json.dumps(value, sort_keys=True, default=str, separators=(",", ":"))
+    return "sha256:" + hashlib.sha256(text.encode("utf-8")).hexdigest()[:HASH_DIGITS]
+
+
+def _compact(value: Any) -> Any:
+    text = json.dumps(value, sort_keys=True, default=str, separators=(",", ":"))
+    return value if len(text) <= MAX_INLINE else short_hash(value)
+
 
 def provenance(**settings: Any) -> dict[str, Any]:
-    """A JSON-ready record: package, version, time, python, torch, plus ``settings``."""
+    """A JSON-ready record: package, version, time, python, torch, the hash of all
+    ``settings`` and the settings themselves."""
     from metainterface import __version__
 
     return {
@@ -20,10 +46,20 @@ def provenance(**settings: Any) -> dict[str, Any]:
         "created": datetime.now(UTC).isoformat(timespec="seconds"),
         "python": platform.python_version(),
         "torch": str(torch.__version__),
+        "inputs_sha256": short_hash(settings),
         "settings": settings,
     }
 
 
+def compact_provenance(**settings: Any) -> dict[str, Any]:
+    """:func:`provenance` with each long setting replaced by its short hash."""
+    record = provenance(**settings)
+    record["settings"] = {k: _compact(v) for k, v in settings.items()}
+    return record
+
+
 def csv_header(**settings: Any) -> str:
-    """A '# ' comment line for CSV files (numpy and pandas(comment='#') skip it)."""
-    return "# " + json.dumps(provenance(**settings), sort_keys=True, default=str) + "\n"
+    """A '# ' comment line for CSV files (numpy and pandas(comment='#') skip it), its
+    settings compacted (:func:`compact_provenance`)."""
+    record = compact_provenance(**settings)
+    return "# " + json.dumps(record, sort_keys=True, default=str) + "\n"

@@ -4,6 +4,7 @@ from metainterface.api.functions import compare, curve, design, export, physical
 from metainterface.api.results import Curve, DesignResult
 from metainterface.api.training import evaluate_surrogate, generate_dataset, train_surrogate
 from metainterface.api.validation_files import validate, validate_many, write_result
+from metainterface.api.view import view
 
 __all__ = [
     "Curve",
@@ -19,5 +20,6 @@ __all__ = [
     "train_surrogate",
     "validate",
     "validate_many",
+    "view",
     "write_result",
 ]

@@ -87,6 +87,7 @@ def design(
     area: str | float | None = None,
     meta: dict[str, Any] | None = None,
     refine_settings: RefineSettings | None = None,
+    full_target: bool = False,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target.
 
@@ -133,6 +134,9 @@ def design(
     refine_settings : RefineSettings
         The refinement's stages, iterations and tolerances (default: the paper's 5 stages x
         5 steps x 20 iterations, then the polish); fewer make a quicker, rougher design.
+    full_target : bool
+        With ``out``: also write the whole target to target.csv (design.json keeps it
+        decimated to at most 256 points, with its size and hash).
 
     Returns
     -------
@@ -151,6 +155,8 @@ def design(
         raise MetainterfaceError("refine_settings must be a RefineSettings")
     if not isinstance(refine, bool):
         raise MetainterfaceError(f"refine must be True or False, got {refine!r}")
+    if not isinstance(full_target, bool):
+        raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
     fm = get_model(model)
     limit = _limit(max_pressure, modulus)
     extra_loss = None
@@ -178,7 +184,7 @@ def design(
     if out is not None:
         out = Path(out)
         folders = [out] if single else [out / r.target.name for r in results]
-        _save_all(results, folders, physical, meta)
+        _save_all(results, folders, physical, meta, full_target)
     return results[0] if single else results
 
 
@@ -227,12 +233,13 @@ def _save_all(
     folders: list[Path],
     physical: dict | None,
     meta: dict[str, Any] | None,
+    full_target: bool = False,
 ) -> None:
     for r, folder in zip(results, folders, strict=True):
         extra = {"command": meta} if meta else {}
         if physical is not None:
             extra["physical"] = physical_block(r.design, **physical)
-        r.save(folder, **extra)
+        r.save(folder, full_target=full_target, **extra)
 
 
 def compare(
@@ -244,12 +251,14 @@ def compare(
     """Design every target with all three methods (paper fig. 5): {method: [results]}.
 
     ``options`` are those of :func:`design`; with ``out``, each method's files go to
-    ``out/<target>/<method>/`` and the comparison figure to ``out/<target>/compare.png``.
+    ``out/<target>/<method>/`` and the comparison figure to ``out/<target>/compare.png``
+    (one target: ``out/<method>/`` and ``out/compare.png``).
     """
-    items, _ = _targets(targets)
+    items, single = _targets(targets)
     if "method" in options:
         raise MetainterfaceError("compare runs every method; leave method out")
     meta = options.pop("meta", None)
+    full_target = options.pop("full_target", False)
     physical = _physical_options(
         options.pop("radius", None),
         options.get("modulus"),
@@ -266,9 +275,10 @@ def compare(
         out = Path(out)
         for i, t in enumerate(items):
             per = [by_method[m][i] for m in pipeline.METHODS]
-            _save_all(per, [out / t.name / r.method for r in per], physical, meta)
+            base = out if single else out / t.name
+            _save_all(per, [base / r.method for r in per], physical, meta, full_target)
             fig = plot_comparison([per], [[r.curve() for r in per]])
-            save_figure(fig, out / t.name / "compare.png", command="compare")
+            save_figure(fig, base / "compare.png", command="compare")
     return by_method  # type: ignore[return-value]
 
 

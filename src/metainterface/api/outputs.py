@@ -1,4 +1,4 @@
-"""What a design writes: design.json, target.csv, curve.csv, design.png in one folder."""
+"""What a design writes: design.json, curve.csv, design.png (and target.csv) in one folder."""
 
 from __future__ import annotations
 
@@ -12,18 +12,31 @@ if TYPE_CHECKING:
     from metainterface.api.results import DesignResult
 
 
-def write_design_outputs(folder: Path, result: DesignResult, **extra: Any) -> Path:
-    """Write the four outputs of one designed cell into ``folder``; returns design.json.
+def write_design_outputs(
+    folder: Path, result: DesignResult, *, full_target: bool = False, **extra: Any
+) -> Path:
+    """Write the outputs of one designed cell into ``folder``; returns design.json.
 
-    ``extra`` keys (the command line, a pressure check, the physical block) are stored in
-    design.json beside the design and how it was made.
+    design.json holds the target once, decimated for figures; ``full_target`` writes the
+    whole target to target.csv beside it. ``extra`` keys (the command line, a pressure
+    check, the physical block) are stored in design.json beside the design.
     """
     t = result.target
     folder.mkdir(parents=True, exist_ok=True)
-    write_columns(folder / "target.csv", {"p_star": t.p_star, "alpha": t.alpha}, target=t.name)
+    record = result.record()
+    if full_target:
+        write_columns(
+            folder / "target.csv",
+            {"p_star": t.p_star, "alpha": t.alpha},
+            target=t.name,
+            sha256=record["target"]["sha256"],
+        )
     curve = result.curve()
     write_columns(folder / "curve.csv", curve.columns(), target=t.name, method=result.method)
     save_figure(
-        plot_design(result, curve), folder / "design.png", target=t.name, method=result.method
+        plot_design(result, result.figure_curve()),
+        folder / "design.png",
+        target=t.name,
+        method=result.method,
     )
-    return result.design.save(folder / "design.json", **result.record(), **extra)
+    return result.design.save(folder / "design.json", **record, **extra)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -10,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import torch
 
+from metainterface._files.provenance import HASH_DIGITS
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.limits import PressureCheck
@@ -21,6 +23,9 @@ if TYPE_CHECKING:
 
 #: Delta samples of a curve when none are asked for.
 CURVE_STEPS = 256
+#: Most points of a target curve stored in design.json (the full one goes to target.csv
+#: only when asked): enough to draw it, small whatever the size of the user's file.
+RECORD_POINTS = 256
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -86,11 +91,27 @@ def design_curve(
     *,
     steps: int = CURVE_STEPS,
     smooth: float | None = None,
+    resolve_engagement: bool = False,
 ) -> Curve:
-    """The :class:`Curve` of a design under a forward model (float64, no gradients)."""
+    """The :class:`Curve` of a design under a forward model (float64, no gradients).
+
+    resolve_engagement: add Delta samples clustered geometrically just after each asperity
+    touches (Delta = h_i), where S* dips towards 0 over a tiny range of Delta that a uniform
+    sweep samples at random depths (for figures: S* then draws as clean cusps, not spikes).
+    """
     m = get_model(model)
     with torch.no_grad():
-        sw = m.design_sweep(design, n_delta=steps, smooth=smooth)
+        if resolve_engagement:
+            delta = torch.as_tensor(_engagement_grid(design, steps))
+            sw = m.sweep(
+                torch.as_tensor(design.gamma)[None],
+                torch.as_tensor(design.h)[None],
+                design.settings,
+                smooth=smooth,
+                delta=delta,
+            )
+        else:
+            sw = m.design_sweep(design, n_delta=steps, smooth=smooth)
     delta = sw.delta if sw.delta.dim() == 1 else sw.delta[0]
     return Curve(
         delta=delta.numpy().copy(),
@@ -99,6 +120,23 @@ def design_curve(
         stiffness=sw.stiffness[0].numpy().copy(),
         model=m.label,
     )
+
+
+def _engagement_grid(design: Design, steps: int) -> np.ndarray:
+    """(K,) sorted Delta in [0, Delta_max]: ``steps`` uniform ones plus 24 per asperity,
+    geometric from 1e-7 to 0.05 Delta_max after its engagement."""
+    d_max = design.settings.delta_max
+    h = design.h - design.h.min()
+    after = h[:, None] + d_max * np.geomspace(1e-7, 5e-2, 24)[None, :]
+    grid = np.concatenate([np.linspace(0.0, d_max, steps), h, after.ravel()])
+    return np.unique(grid[(grid >= 0) & (grid <= d_max)])
+
+
+def decimate(n: int, most: int = RECORD_POINTS) -> np.ndarray:
+    """Indices of at most ``most`` of ``n`` points, evenly spread, first and last kept."""
+    if n <= most:
+        return np.arange(n)
+    return np.unique(np.linspace(0, n - 1, most).round().astype(int))
 
 
 @dataclass(frozen=True, repr=False)
@@ -153,22 +191,33 @@ class DesignResult:
         ax.set_title(self.target.name)
         return ax
 
-    def figure(self) -> Figure:
-        """The full design figure: curves, stiffness, parameters, the cell seen from above."""
+    def figure(self, *, width: float | None = None) -> Figure:
+        """The full design figure: alpha(P*) and S*(P*) against the target, the friction law
+        in newtons when the target came from one, the parameters and the cell seen from
+        above. width: figure width in inches (default: the figure's own)."""
         from metainterface.plots import plot_design
 
-        return plot_design(self, self.curve())
+        return plot_design(self, self.figure_curve(), width=width)
+
+    def figure_curve(self) -> Curve:
+        """The design's curve for figures: dense, with every engagement resolved."""
+        return design_curve(self.design, self.model, steps=1024, resolve_engagement=True)
 
     def record(self) -> dict[str, Any]:
-        """What design.json stores about how the design was made."""
+        """What design.json stores about how the design was made: the target decimated to
+        at most ``RECORD_POINTS`` points (with its size and the hash of the full curve)."""
         t = self.target
+        keep = decimate(t.p_star.size)
         return {
             "target": {
                 "name": t.name,
                 "source": t.source,
-                "p_star": t.p_star.tolist(),
-                "alpha": t.alpha.tolist(),
-                **t.meta,
+                "points": int(t.p_star.size),
+                "sha256": _array_hash(t.p_star, t.alpha),
+                **({"stored_points": int(keep.size)} if keep.size < t.p_star.size else {}),
+                "p_star": t.p_star[keep].tolist(),
+                "alpha": t.alpha[keep].tolist(),
+                **_compact_meta(t.meta),
             },
             "method": self.method,
             "model": self.model.label,
@@ -180,12 +229,15 @@ class DesignResult:
             **({"pressure_check": self.pressure.to_dict()} if self.pressure else {}),
         }
 
-    def save(self, folder: str | os.PathLike[str], **extra: Any) -> Path:
-        """Write design.json, target.csv, curve.csv and design.png into ``folder``; ``extra``
-        keys go into design.json. Returns the path of design.json."""
+    def save(
+        self, folder: str | os.PathLike[str], *, full_target: bool = False, **extra: Any
+    ) -> Path:
+        """Write design.json, curve.csv and design.png into ``folder`` (and target.csv, the
+        whole target, with ``full_target``); ``extra`` keys go into design.json. Returns the
+        path of design.json."""
         from metainterface.api.outputs import write_design_outputs
 
-        return write_design_outputs(Path(folder), self, **extra)
+        return write_design_outputs(Path(folder), self, full_target=full_target, **extra)
 
     def __repr__(self) -> str:
         note = f", note: {self.notes[0]}" if self.notes else ""
@@ -195,6 +247,28 @@ class DesignResult:
             f"zero-shot {_percent(self.initial_error)}, {self.seconds:.2f} s, "
             f"design={self.design!r}{note})"
         )
+
+
+def _array_hash(*arrays: np.ndarray) -> str:
+    """'sha256:<hex>' of float64 arrays' bytes: names a curve without storing it."""
+    digest = hashlib.sha256()
+    for a in arrays:
+        digest.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    return "sha256:" + digest.hexdigest()[:HASH_DIGITS]
+
+
+def _compact_meta(meta: dict[str, Any]) -> dict[str, Any]:
+    """The target's meta with the friction law's force lists decimated like the target."""
+    friction = meta.get("friction")
+    if not isinstance(friction, dict) or "normal_force_n" not in friction:
+        return meta
+    fn, ff = friction["normal_force_n"], friction["friction_force_n"]
+    keep = decimate(len(fn))
+    law = {**friction, "normal_force_n": [fn[i] for i in keep]}
+    law["friction_force_n"] = [ff[i] for i in keep]
+    if keep.size < len(fn):
+        law["law_points"] = len(fn)
+    return {**meta, "friction": law}
 
 
 def _percent(x: float) -> str:

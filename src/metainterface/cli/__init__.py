@@ -24,6 +24,7 @@ COMMANDS: tuple[str, ...] = (
     "export",
     "validate",
     "reproduce",
+    "view",
 )
 
 

@@ -54,7 +54,9 @@ def run(args: argparse.Namespace) -> int:
 
         from metainterface.plots import plot_curve, save_figure
 
-        save_figure(plot_curve(c, title=Path(args.design).name), args.plot, command="curve")
+        path = Path(args.design)  # "FOLDER: design.json": the file name alone is often the same
+        title = f"{path.parent.name}: {path.name}" if path.parent.name else path.name
+        save_figure(plot_curve(c, title=title), args.plot, command="curve")
     print(
         f"{args.out}: {args.steps} points ({c.model}), "
         f"P*_max = {c.p_star_max:.4g}, alpha_max = {c.alpha_max:.4g}"

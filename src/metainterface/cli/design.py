@@ -14,8 +14,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "design",
         help="design a unit cell for a target contact law (the main job)",
         description="Zero-shot prediction by the shipped surrogate, then multi-stage L-BFGS "
-        "refinement (or a multistart / Hertz-only baseline). Writes design.json, target.csv, "
-        "curve.csv and design.png into --out (one folder per target when there are several).",
+        "refinement (or a multistart / Hertz-only baseline). Writes design.json, curve.csv "
+        "and design.png into --out (one folder per target when there are several).",
     )
     src = p.add_argument_group("targets (one or more)")
     src.add_argument(
@@ -45,6 +45,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     phys.add_argument("--area", help="nominal area of the whole interface, e.g. 4cm2")
     phys.add_argument("--total-force", help="total normal force, e.g. 10N (number of cells)")
     p.add_argument("--out", required=True, help="output folder")
+    p.add_argument(
+        "--full-target",
+        action="store_true",
+        help="also write the whole target to target.csv (design.json keeps it decimated)",
+    )
+    p.add_argument(
+        "--html",
+        action="store_true",
+        help="also write view.html, an interactive page of each design (needs the [view] extra)",
+    )
     p.add_argument("--method", choices=METHODS, default="surrogate")
     p.add_argument("--refine", choices=("lbfgs", "none"), default="lbfgs")
     p.add_argument(
@@ -145,9 +155,13 @@ def run(args: argparse.Namespace) -> int:
         area=args.area if args.total_force is None else None,
         settings=_settings(args),
         meta=_command(args),
+        full_target=args.full_target,
     )
     if args.compare:
-        by_method = mi.compare(targets, out=args.out, **options)
+        if args.html:
+            raise mi.MetainterfaceError("--html draws one design per page; leave out --compare")
+        one = targets[0] if len(targets) == 1 else targets  # one target: files in --out
+        by_method = mi.compare(one, out=args.out, **options)
         results = [r for m in by_method.values() for r in m]
     else:  # one target: its files directly in --out; several: one folder each
         made = mi.design(
@@ -169,6 +183,13 @@ def run(args: argparse.Namespace) -> int:
             f"{r.target.name:<{width}}{r.method:<12}{100 * r.initial_error:>9.3g} %"
             f"{100 * r.error:>9.3g} %{r.seconds:>9.2f}"
         )
+    if args.html:  # one page per design folder
+        from pathlib import Path
+
+        out = Path(args.out)
+        for r in results:
+            page = mi.view(out if len(results) == 1 else out / r.target.name)
+            print(f"{page}: interactive view, opens in a browser")
     print(f"written to {args.out}")
     return 0
 

@@ -2,31 +2,35 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from metainterface.plots.common import new_figure
+from metainterface.errors import MetainterfaceError
+from metainterface.plots.common import panel_grid, short, tidy_axis
 
 
 def plot_dataset_examples(
-    examples: Mapping[str, Mapping[str, np.ndarray]], *, title: str | None = None
+    examples: Mapping[str, Mapping[str, np.ndarray]],
+    *,
+    title: str | None = None,
+    width: float | None = None,
 ) -> Figure:
     """One panel per entry of ``examples`` (in its order): alpha against P* of a few samples.
 
     examples: panel title -> arrays of k samples: p_star_max (k,), alpha_max (k,) and
         alpha_hat (k, n) on the uniform grid P / P*_max in [0, 1] (the dataset's arrays).
     Curves are drawn de-normalised, alpha = alpha_hat alpha_max against P* = P_hat P*_max,
-    as solid black lines (shades of grey tell the samples apart).
+    as solid black lines (shades of grey tell the samples apart). width: inches (default
+    3.4 per panel, three per row).
     """
     panels = list(examples.items())
-    cols = min(3, max(1, len(panels)))
-    rows = max(1, math.ceil(len(panels) / cols))
-    fig = new_figure(3.4 * cols, 2.9 * rows)
-    axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False).ravel())
-    for ax, (name, arrays) in zip(axes, panels, strict=False):
+    if not panels:
+        raise MetainterfaceError("plot_dataset_examples: give at least one category")
+    width = 3.4 * min(3, len(panels)) if width is None else width
+    fig, axes = panel_grid(len(panels), width, max_cols=3, aspect=0.85)
+    for ax, (name, arrays) in zip(axes, panels, strict=True):
         alpha_hat = np.asarray(arrays["alpha_hat"], dtype=np.float64)
         p_max = np.asarray(arrays["p_star_max"], dtype=np.float64)
         a_max = np.asarray(arrays["alpha_max"], dtype=np.float64)
@@ -35,15 +39,13 @@ def plot_dataset_examples(
         for i in range(k):
             shade = str(0.55 * i / max(1, k - 1))
             ax.plot(p_hat * p_max[i], alpha_hat[i] * a_max[i], color=shade, lw=1.2)
-        ax.set_title(name, fontsize=9)
+        ax.set_title(short(name, 28), fontsize=9)
         ax.set_xlabel(r"$P^* = P/E^*$")
         ax.set_ylabel(r"$\alpha = A/A_{nom}$")
         ax.set_xlim(left=0)
         ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
-        ax.ticklabel_format(axis="both", style="sci", scilimits=(-2, 3))
-    for ax in axes[len(panels) :]:
-        ax.set_visible(False)
+        tidy_axis(ax, bins=4)
     if title:
-        fig.suptitle(title, fontsize=9)
+        fig.suptitle(short(title), fontsize=10)
     return fig

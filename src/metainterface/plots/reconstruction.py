@@ -6,19 +6,20 @@ from __future__ import annotations
 import numpy as np
 import torch
 from matplotlib.figure import Figure
-from matplotlib.ticker import MaxNLocator
 
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import sweep
-from metainterface.plots.common import new_figure
+from metainterface.plots.common import panel_grid, percent, tidy_axis
 
 ORDER = ("lhs", "mixed", "truncated", "bimodal", "coplanar", "stratified")
 
 
-def plot_reconstructions(test, pred, settings: CellSettings, per_category: int = 3) -> Figure:
-    """test: the dataset's test subset; pred: :class:`Predictions` of the same rows."""
-    fig = new_figure(12.0, 7.0)
-    axes = fig.subplots(2, 3).ravel()
+def plot_reconstructions(
+    test, pred, settings: CellSettings, per_category: int = 3, *, width: float = 12.0
+) -> Figure:
+    """test: the dataset's test subset; pred: :class:`Predictions` of the same rows.
+    width: inches (three panels per row when they fit)."""
+    fig, axes = panel_grid(6, width, max_cols=3, min_panel=3.4, aspect=0.85)
     p_hat = np.linspace(0, 1, settings.n_steps)
     for ax, (letter, name) in zip(axes, zip("abcdef", ORDER, strict=True), strict=True):
         rows = np.flatnonzero(test.category == name)
@@ -41,11 +42,12 @@ def plot_reconstructions(test, pred, settings: CellSettings, per_category: int =
                 "--",
                 color=color,
                 lw=1.4,
-                label=f"err {100 * pred.curve_error[i]:.1f} %",
+                label=f"err {percent(pred.curve_error[i])}",
             )
         ax.set(title=f"({letter}) {name}", xlabel="$P^*$", ylabel=r"$\alpha$")
-        ax.xaxis.set_major_locator(MaxNLocator(4))
-        ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 2))
+        ax.set_xlim(left=0)
+        ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
+        tidy_axis(ax, bins=4)
         ax.legend(fontsize=7, title="true (black) / predicted", title_fontsize=7)
     return fig

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from matplotlib.figure import Figure
 
-from metainterface.plots.common import new_figure
+from metainterface.plots.common import panel_grid, percent, short, tidy_axis
 
 if TYPE_CHECKING:
     from metainterface.validation.validate import ValidationResult
@@ -18,11 +18,12 @@ def plot_validation(
     *,
     target: tuple[np.ndarray, np.ndarray] | None = None,
     title: str | None = None,
+    width: float = 13.0,
 ) -> Figure:
     """Three panels: alpha(P*) (target, model, BEM), the cell's height map, p/E* at the
-    largest load. target: optional (p_star, alpha) arrays of the design's target curve."""
-    fig = new_figure(width=13.0, height=4.0)
-    ax_c, ax_h, ax_p = fig.subplots(1, 3)
+    largest load. target: optional (p_star, alpha) arrays of the design's target curve.
+    title: a name (a path is cut to its file name); width: inches."""
+    fig, (ax_c, ax_h, ax_p) = panel_grid(3, width, min_panel=3.6, aspect=0.82)
     p_top = float(result.p_star[-1])
     keep = result.curve.p_star <= p_top * (1 + 1e-12)
     if target is not None:
@@ -46,14 +47,12 @@ def plot_validation(
     ax_c.set_xlim(left=0)
     ax_c.set_ylim(bottom=0)
     ax_c.grid(alpha=0.3)
-    ax_c.legend(fontsize=8, loc="lower right")
-    ax_c.text(
-        0.03,
-        0.97,
-        f"max |rel. err.| (upper half) = {100 * result.max_rel_err_upper:.2f} %",
-        transform=ax_c.transAxes,
-        va="top",
+    tidy_axis(ax_c)
+    ax_c.legend(
         fontsize=8,
+        loc="lower right",
+        title=f"max |rel. err.|, upper half: {percent(result.max_rel_err_upper)}",
+        title_fontsize=8,
     )
 
     radius = result.design.settings.radius  # axes in units of R
@@ -66,10 +65,12 @@ def plot_validation(
     im = ax_h.imshow(z, origin="lower", extent=extent, cmap="viridis", vmin=z_low, vmax=0.0)
     ax_h.set(xlabel="x / R", ylabel="y / R", title="topography")
     fig.colorbar(im, ax=ax_h, label="z / R", shrink=0.85, extend="min")
+    tidy_axis(ax_h, bins=4)
 
     im = ax_p.imshow(result.pressure, origin="lower", extent=extent, cmap="magma")
     ax_p.set(xlabel="x / R", ylabel="y / R", title=rf"$p/E^*$ at $P^* = {p_top:.3g}$")
     fig.colorbar(im, ax=ax_p, label=r"$p/E^*$", shrink=0.85)
+    tidy_axis(ax_p, bins=4)
     if title:
-        fig.suptitle(title, fontsize=9)
+        fig.suptitle(short(title), fontsize=10)
     return fig

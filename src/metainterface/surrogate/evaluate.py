@@ -101,8 +101,8 @@ def format_table(result: dict) -> str:
     ]
     for name, r in result["categories"].items():
         lines.append(
-            f"| {name} | {r['samples']} | {100 * r['median_curve_error']:.2f} % | "
-            f"{100 * r['p90_curve_error']:.2f} % | {r['mean_abs_log10_p_star_max_error']:.4f} | "
+            f"| {name} | {r['samples']} | {100 * r['median_curve_error']:.3g} % | "
+            f"{100 * r['p90_curve_error']:.3g} % | {r['mean_abs_log10_p_star_max_error']:.4f} | "
             f"{r['mean_abs_log10_alpha_max_error']:.4f} |"
         )
     lines.append(
