@@ -23,6 +23,9 @@ Curves and forward models
     curve, Curve, ForwardModel, Independent, Interacting, MODELS, get_model, register_model
 Checking and making
     validate, validate_many, ValidationResult, write_result, export
+Manufacturing errors
+    tolerance, ToleranceResult (the band of alpha(P*) and the error under height, shape and
+    scale errors), min_radius, PrinterSizing (the smallest R for a printer's height error)
 Your own design space
     generate_dataset, train_surrogate, TrainConfig, evaluate_surrogate
 Process settings
@@ -38,14 +41,18 @@ from importlib.metadata import PackageNotFoundError, version
 from metainterface.api import (
     Curve,
     DesignResult,
+    PrinterSizing,
+    ToleranceResult,
     compare,
     curve,
     design,
     evaluate_surrogate,
     export,
     generate_dataset,
+    min_radius,
     physical,
     pressure_check,
+    tolerance,
     train_surrogate,
     validate,
     validate_many,
@@ -81,7 +88,9 @@ __all__ = [
     "Independent",
     "Interacting",
     "MetainterfaceError",
+    "PrinterSizing",
     "Target",
+    "ToleranceResult",
     "TrainConfig",
     "ValidationResult",
     "__version__",
@@ -92,9 +101,11 @@ __all__ = [
     "export",
     "generate_dataset",
     "get_model",
+    "min_radius",
     "physical",
     "pressure_check",
     "register_model",
+    "tolerance",
     "train_surrogate",
     "tune_allocator",
     "validate",

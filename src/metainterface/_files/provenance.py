@@ -10,11 +10,14 @@ from typing import Any
 import torch
 
 
-def provenance(**settings: Any) -> dict[str, Any]:
-    """A JSON-ready record: package, version, time, python, torch, plus ``settings``."""
+def provenance(*, stamp: bool = True, **settings: Any) -> dict[str, Any]:
+    """A JSON-ready record: package, version, time, python, torch, plus ``settings``.
+
+    ``stamp=False`` leaves the creation time out, for files that must be byte-identical
+    when made again with the same seed (the time then goes into a file beside them)."""
     from metainterface import __version__
 
-    return {
+    record = {
         "package": "metainterface",
         "version": __version__,
         "created": datetime.now(UTC).isoformat(timespec="seconds"),
@@ -22,8 +25,12 @@ def provenance(**settings: Any) -> dict[str, Any]:
         "torch": str(torch.__version__),
         "settings": settings,
     }
+    if not stamp:
+        del record["created"]
+    return record
 
 
-def csv_header(**settings: Any) -> str:
+def csv_header(*, stamp: bool = True, **settings: Any) -> str:
     """A '# ' comment line for CSV files (numpy and pandas(comment='#') skip it)."""
-    return "# " + json.dumps(provenance(**settings), sort_keys=True, default=str) + "\n"
+    record = provenance(stamp=stamp, **settings)
+    return "# " + json.dumps(record, sort_keys=True, default=str) + "\n"
