@@ -25,6 +25,7 @@ from metainterface import _checks
 from metainterface._files import provenance, write_columns, write_text
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import tolerance as tol
+from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
 from metainterface.inverse.targets import Target
 from metainterface.physical.units import parse_pressure, parse_quantity
 from metainterface.physics.cell import Design
@@ -39,7 +40,7 @@ MIN_SAMPLES, MAX_SAMPLES = 16, 262_144
 BAND_COLUMNS = ("p_star", "alpha_nominal", "alpha_p05", "alpha_p50", "alpha_p95")
 
 
-def _length_in_r(value: Any, radius_m: float | None, *, option: str, radius_option: str) -> float:
+def length_in_r(value: Any, radius_m: float | None, *, option: str, radius_option: str) -> float:
     """A length >= 0 in units of R: a plain number is already in units of R; a quantity with
     a unit ('1um') is divided by the radius, which it then needs."""
     if isinstance(value, str):
@@ -134,7 +135,7 @@ class Settings:
     model: str
     radius_m: float | None
     reference: str
-    gamma_floor: float = tol.GAMMA_FLOOR
+    gamma_floor: float = GAMMA_FLOOR
 
     def to_dict(self) -> dict[str, Any]:
         out = dict(self.__dict__)
@@ -343,13 +344,13 @@ def tolerance(
     """
     names = {**_NAMES, **(option_names or {})}
     d, fm, samples, seed, ref, r_m = _prepare(design, model, samples, seed, target, radius, names)
-    s_h = _length_in_r(sigma_h, r_m, option=names["sigma_h"], radius_option=names["radius"])
+    s_h = length_in_r(sigma_h, r_m, option=names["sigma_h"], radius_option=names["radius"])
     s_g = _checks.number(names["sigma_gamma"], sigma_gamma, low=0.0)
     s_s = _checks.number(names["scale_sigma"], scale_sigma, low=0.0, high=0.5)
     tau = _stress(shear_strength, d, ("shear_strength_pa",), names["shear_strength"])
     e_star = _stress(modulus, d, ("e_star_pa",), names["modulus"])
     t0 = time.perf_counter()
-    pert = tol.Perturbation.draw(
+    pert = Perturbation.draw(
         d.n_asperities, samples, seed, sigma_h=s_h, sigma_gamma=s_g, scale_sigma=s_s
     )
     sp = tol.spread(
@@ -496,7 +497,7 @@ def min_radius(
     budget = _max_error(max_error, names["max_error"])
     s_g = _checks.number(names["sigma_gamma"], sigma_gamma, low=0.0)
     s_s = _checks.number(names["scale_sigma"], scale_sigma, low=0.0, high=0.5)
-    pert = tol.Perturbation.draw(
+    pert = Perturbation.draw(
         d.n_asperities, samples, seed, sigma_h=0.0, sigma_gamma=s_g, scale_sigma=s_s
     )
     with torch.no_grad():
