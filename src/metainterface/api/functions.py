@@ -472,6 +472,7 @@ def export(
     format: str | None = None,
     resolution: float | None = None,
     base: str | float = "1mm",
+    z_step: str | float | None = None,
 ) -> dict[str, Any]:
     """Write the design's surface for manufacture: STL (mm), 16-bit PNG/TIFF or NPY (m).
 
@@ -490,6 +491,11 @@ def export(
         Grid points per mm (default 64 per asperity pitch).
     base : str or float
         STL base plate thickness under the surface (default 1 mm).
+    z_step : str or float
+        A printer's layer height ('1um', or a plain number in units of R), at most
+        Delta_max: the asperities' height offsets are snapped to its multiples (a design
+        made with ``design(..., z_step=...)`` already sits on them; the sidecar records the
+        largest shift).
 
     Returns
     -------
@@ -502,10 +508,21 @@ def export(
     if resolution is not None:
         resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
     source = str(design) if isinstance(design, str | os.PathLike) else None
+    radius_m = parse_length(radius, option="radius")
+    step = None
+    if z_step is not None:
+        from metainterface.api.tolerance import length_in_r
+
+        step = length_in_r(z_step, radius_m, option="z_step", radius_option="radius")
+        if not 0 < step <= d.settings.delta_max:
+            raise MetainterfaceError(
+                f"z_step must be in (0, Delta_max = {d.settings.delta_max:g} R], got {step:g} R"
+            )
     return export_design(
         d,
         path,
-        radius=parse_length(radius, option="radius"),
+        z_step=step,
+        radius=radius_m,
         tiles=tiles,
         fmt=format,
         resolution=resolution,
