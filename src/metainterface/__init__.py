@@ -25,7 +25,9 @@ Checking and making
     validate, validate_many, ValidationResult, write_result, export
 Manufacturing errors
     tolerance, ToleranceResult (the band of alpha(P*) and the error under height, shape and
-    scale errors), min_radius, PrinterSizing (the smallest R for a printer's height error)
+    scale errors), min_radius, PrinterSizing (the smallest R for a printer's height error);
+    design(..., robust=True, sigma_h=..., sigma_gamma=...) designs for such errors,
+    design(..., z_step=...) and export(..., z_step=...) put heights on a printer's layers
 Your own design space
     generate_dataset, train_surrogate, TrainConfig, evaluate_surrogate
 Process settings

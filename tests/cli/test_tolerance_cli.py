@@ -73,3 +73,9 @@ def test_length_without_radius_exit_2(design_file, tmp_path, capsys):
     argv = ["tolerance", design_file, "--sigma-h", "1um", "--out", str(tmp_path / "x")]
     assert main(argv) == 2
     assert "--radius" in capsys.readouterr().err
+
+
+def test_model_choice_from_the_registry(design_file, tmp_path):
+    assert run(design_file, tmp_path / "i", "--model", "interacting", "--samples", "16") == 0
+    rec = json.loads((tmp_path / "i" / "tolerance.json").read_text())
+    assert rec["settings"]["model"] == "interacting"

@@ -205,7 +205,7 @@ class ToleranceResult:
                 "error_median": self.error_median_linear,
                 "error_p95": self.error_p95_linear,
                 "error_rms": self.error_rms_linear,
-                "band_halfwidth_max": float(np.max(1.6448536269514722 * self.alpha_sd_linear)),
+                "band_halfwidth_max": float(np.max(tol.Z95 * self.alpha_sd_linear)),
             },
             "band_halfwidth_max": float(np.max(self.alpha_p95 - self.alpha_p05) / 2),
             "reference": self.settings.reference,
