@@ -468,6 +468,7 @@ def min_radius(
     model: str | ForwardModel | None = None,
     target: Target | str | None = None,
     option_names: dict[str, str] | None = None,
+    progress: bool = False,
 ) -> PrinterSizing:
     """What printer a design needs: the smallest asperity radius R at which a printer's
     absolute height error keeps the p95 relative curve error within ``max_error``.
@@ -485,6 +486,8 @@ def min_radius(
         The p95 error budget: a fraction (0.05) or a percentage ('5%').
     sigma_gamma, scale_sigma, samples, seed, model, target
         As in :func:`tolerance` (fewer samples by default: about 30 probes are run).
+    progress : bool
+        Show a progress bar of the probes (on stderr, once the search takes over 2 s).
 
     Returns
     -------
@@ -500,7 +503,18 @@ def min_radius(
     pert = Perturbation.draw(
         d.n_asperities, samples, seed, sigma_h=0.0, sigma_gamma=s_g, scale_sigma=s_s
     )
-    with torch.no_grad():
+    from tqdm.auto import tqdm
+
+    with (
+        torch.no_grad(),
+        tqdm(
+            total=tol.SEARCH_STEPS + 3,
+            desc="radius search",
+            unit="probe",
+            delay=2.0,
+            disable=not progress,
+        ) as bar,
+    ):
         s_h, err = tol.largest_sigma(
             d.gamma,
             d.h,
@@ -509,6 +523,8 @@ def min_radius(
             pert,
             budget,
             target=None if ref is None else (ref.p_star, ref.alpha),
+            iterations=tol.SEARCH_STEPS,
+            progress=bar.update,
         )
     radius_m = math.inf if s_h == 0.0 else sigma_m / s_h  # s_h = inf: any R (0)
     unit = radius_m / d.settings.radius

@@ -106,6 +106,7 @@ def run(args: argparse.Namespace) -> int:
             args.design,
             printer_sigma=args.printer_sigma,
             max_error=args.max_error,
+            progress=True,
             **({} if args.samples is None else {"samples": args.samples}),
             **common,
         )
