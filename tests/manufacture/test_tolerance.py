@@ -155,3 +155,18 @@ def test_min_radius_is_where_the_p95_meets_the_budget():
         mi.min_radius(d, printer_sigma="1um", max_error="five")
     with pytest.raises(mi.MetainterfaceError, match="printer_sigma"):
         mi.min_radius(d, printer_sigma="1kg", max_error=0.05)
+
+
+def test_scale_error_scales_every_height_of_a_sample_alike():
+    d = mi.Design(gamma=[2.0, 3.0, 2.5, 3.5], h=[0.0, 0.004, 0.01, 0.013])
+    r = mi.tolerance(d, scale_sigma=0.05, samples=256, seed=2, target="nominal")
+    ratio = r.h[:, 1:] / d.h[1:]
+    np.testing.assert_allclose(ratio, ratio[:, :1].repeat(3, 1), rtol=1e-12)
+    assert abs(ratio[:, 0].std() - 0.05) < 0.01 and r.error_p95 > 0
+
+
+def test_radius_defaults_to_the_design_files_physical_block(tmp_path):
+    d = mi.Design(gamma=[2.0, 3.0, 2.5, 3.5], h=[0.0, 0.004, 0.01, 0.013])
+    path = d.save(tmp_path / "d.json", physical={"radius_m": 5e-4})
+    r = mi.tolerance(path, sigma_h="1um", samples=16)
+    assert r.settings.radius_m == 5e-4 and r.settings.sigma_h == pytest.approx(0.002)
