@@ -25,6 +25,11 @@ Checking and making
     validate, validate_many, ValidationResult, write_result, export
 Looking at a design
     view (an interactive, self-contained HTML page; the [view] extra), DesignResult.figure
+Manufacturing errors
+    tolerance, ToleranceResult (the band of alpha(P*) and the error under height, shape and
+    scale errors), min_radius, PrinterSizing (the smallest R for a printer's height error);
+    design(..., robust=True, sigma_h=..., sigma_gamma=...) designs for such errors,
+    design(..., z_step=...) and export(..., z_step=...) put heights on a printer's layers
 Your own design space
     generate_dataset, train_surrogate, TrainConfig, evaluate_surrogate
 Process settings
@@ -40,14 +45,18 @@ from importlib.metadata import PackageNotFoundError, version
 from metainterface.api import (
     Curve,
     DesignResult,
+    PrinterSizing,
+    ToleranceResult,
     compare,
     curve,
     design,
     evaluate_surrogate,
     export,
     generate_dataset,
+    min_radius,
     physical,
     pressure_check,
+    tolerance,
     train_surrogate,
     validate,
     validate_many,
@@ -84,7 +93,9 @@ __all__ = [
     "Independent",
     "Interacting",
     "MetainterfaceError",
+    "PrinterSizing",
     "Target",
+    "ToleranceResult",
     "TrainConfig",
     "ValidationResult",
     "__version__",
@@ -95,9 +106,11 @@ __all__ = [
     "export",
     "generate_dataset",
     "get_model",
+    "min_radius",
     "physical",
     "pressure_check",
     "register_model",
+    "tolerance",
     "train_surrogate",
     "tune_allocator",
     "validate",

@@ -18,13 +18,16 @@ from metainterface.errors import MetainterfaceError
 def write_columns(
     path: str | os.PathLike[str],
     columns: Mapping[str, Sequence[float] | np.ndarray],
+    *,
+    stamp: bool = True,
     **settings: Any,
 ) -> Path:
-    """Write equal-length numeric columns to a CSV with a header row and a '# ' comment line."""
+    """Write equal-length numeric columns to a CSV with a header row and a '# ' comment line
+    (without the creation time if ``stamp`` is False: then the same data give the same bytes)."""
     names = list(columns)
     data = np.column_stack([np.asarray(columns[n], dtype=np.float64) for n in names])
     buf = io.StringIO()
-    buf.write(csv_header(**settings))
+    buf.write(csv_header(stamp=stamp, **settings))
     np.savetxt(buf, data, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
     return write_text(path, buf.getvalue())
 

@@ -35,12 +35,15 @@ def _compact(value: Any) -> Any:
     return value if len(text) <= MAX_INLINE else short_hash(value)
 
 
-def provenance(**settings: Any) -> dict[str, Any]:
+def provenance(*, stamp: bool = True, **settings: Any) -> dict[str, Any]:
     """A JSON-ready record: package, version, time, python, torch, the hash of all
-    ``settings`` and the settings themselves."""
+    ``settings`` and the settings themselves.
+
+    ``stamp=False`` leaves the creation time out, for files that must be byte-identical
+    when made again with the same seed (the time then goes into a file beside them)."""
     from metainterface import __version__
 
-    return {
+    record = {
         "package": "metainterface",
         "version": __version__,
         "created": datetime.now(UTC).isoformat(timespec="seconds"),
@@ -49,17 +52,20 @@ def provenance(**settings: Any) -> dict[str, Any]:
         "inputs_sha256": short_hash(settings),
         "settings": settings,
     }
+    if not stamp:
+        del record["created"]
+    return record
 
 
-def compact_provenance(**settings: Any) -> dict[str, Any]:
+def compact_provenance(*, stamp: bool = True, **settings: Any) -> dict[str, Any]:
     """:func:`provenance` with each long setting replaced by its short hash."""
-    record = provenance(**settings)
+    record = provenance(stamp=stamp, **settings)
     record["settings"] = {k: _compact(v) for k, v in settings.items()}
     return record
 
 
-def csv_header(**settings: Any) -> str:
+def csv_header(*, stamp: bool = True, **settings: Any) -> str:
     """A '# ' comment line for CSV files (numpy and pandas(comment='#') skip it), its
     settings compacted (:func:`compact_provenance`)."""
-    record = compact_provenance(**settings)
+    record = compact_provenance(stamp=stamp, **settings)
     return "# " + json.dumps(record, sort_keys=True, default=str) + "\n"

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +15,7 @@ from metainterface import _checks
 from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline
+from metainterface.inverse.perturb import Perturbation
 from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
 from metainterface.physical.dimensions import physical_block
@@ -88,6 +90,12 @@ def design(
     meta: dict[str, Any] | None = None,
     refine_settings: RefineSettings | None = None,
     full_target: bool = False,
+    robust: bool = False,
+    sigma_h: float | str = 0.0,
+    sigma_gamma: float = 0.0,
+    scale_sigma: float = 0.0,
+    robust_samples: int = 16,
+    z_step: float | str | None = None,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target.
 
@@ -137,6 +145,22 @@ def design(
     full_target : bool
         With ``out``: also write the whole target to target.csv (design.json keeps it
         decimated to at most 256 points, with its size and hash).
+    robust : bool
+        Design for manufacturing errors: each start is refined against the mean squared
+        error of ``robust_samples`` perturbed copies of it (the same draws for every start,
+        in the same batch), the start with the smallest rms error over them wins.
+        ``result.error`` (and design.json's ``relative_error``) stays the nominal design's;
+        ``result.robust`` holds the nominal and robust statistics.
+    sigma_h, sigma_gamma, scale_sigma : float or str
+        The errors designed for, as in :func:`tolerance`: sigma_h a plain number in units
+        of R or a length ('1um') with ``radius``; sigma_gamma absolute; scale_sigma relative.
+    robust_samples : int
+        K, perturbed copies per start, in [1, 1024]; the cost grows about K-fold.
+    z_step : float or str
+        A printer's layer height: the designed heights are snapped to its multiples and the
+        gammas re-refined with the heights fixed. A plain number in units of R, or a length
+        ('1um') with ``radius``; at most Delta_max. ``result.printable`` reports the error
+        before the snap, after it and after the re-refine.
 
     Returns
     -------
@@ -166,6 +190,9 @@ def design(
             return PRESSURE_WEIGHT * pressure_penalty(gamma, h, cell, limit)
 
     physical = _physical_options(radius, modulus, total_force, area)
+    perturb, step, radius_m = _manufacturing(
+        robust, sigma_h, sigma_gamma, scale_sigma, robust_samples, z_step, radius, settings, seed
+    )
     raw = pipeline.design(
         items,
         method,
@@ -179,13 +206,112 @@ def design(
         refine_settings=refine_settings,
         hedge=hedge if method == "surrogate" else 0,
         fallback=fallback if method == "surrogate" else 0,
+        perturb=perturb,
+        z_step=step,
     )
     results = [_public(r, limit, modulus) for r in raw]
+    if perturb is not None:
+        results = [_robust_stats(r, perturb, seed) for r in results]
+    if step is not None:
+        results = [_printable_record(r, radius_m) for r in results]
     if out is not None:
         out = Path(out)
         folders = [out] if single else [out / r.target.name for r in results]
         _save_all(results, folders, physical, meta, full_target)
     return results[0] if single else results
+
+
+#: Made cells drawn to report a robust design's error distribution (independent of the
+#: K copies it was refined against).
+ROBUST_REPORT_SAMPLES = 1024
+MAX_ROBUST_SAMPLES = 1024
+
+
+def _manufacturing(
+    robust: Any,
+    sigma_h: Any,
+    sigma_gamma: Any,
+    scale_sigma: Any,
+    robust_samples: Any,
+    z_step: Any,
+    radius: Any,
+    settings: CellSettings | None,
+    seed: int,
+) -> tuple[Perturbation | None, float | None, float | None]:
+    """The perturbation of a robust design and the layer step [units of R], checked."""
+    from metainterface.api.tolerance import length_in_r
+
+    if not isinstance(robust, bool):
+        raise MetainterfaceError(f"robust must be True or False, got {robust!r}")
+    radius_m = None if radius is None else parse_length(radius, option="radius")
+    cell = settings or CellSettings()
+    step = None
+    if z_step is not None:
+        step = length_in_r(z_step, radius_m, option="z_step", radius_option="radius")
+        if not 0 < step <= cell.delta_max:
+            raise MetainterfaceError(
+                f"z_step must be in (0, Delta_max = {cell.delta_max:g} R], got {step:g} R"
+            )
+    if not robust:
+        if any(v not in (0, 0.0) for v in (sigma_h, sigma_gamma, scale_sigma)):
+            raise MetainterfaceError("sigma_h, sigma_gamma and scale_sigma need robust=True")
+        return None, step, radius_m
+    s_h = length_in_r(sigma_h, radius_m, option="sigma_h", radius_option="radius")
+    s_g = _checks.number("sigma_gamma", sigma_gamma, low=0.0)
+    s_s = _checks.number("scale_sigma", scale_sigma, low=0.0, high=0.5)
+    if s_h == s_g == s_s == 0.0:
+        raise MetainterfaceError("robust=True needs sigma_h, sigma_gamma or scale_sigma > 0")
+    k = _checks.whole("robust_samples", robust_samples, low=1, high=MAX_ROBUST_SAMPLES)
+    perturb = Perturbation.draw(
+        cell.n_asperities, k, seed, sigma_h=s_h, sigma_gamma=s_g, scale_sigma=s_s
+    )
+    return perturb, step, radius_m
+
+
+def _robust_stats(r: DesignResult, perturb: Perturbation, seed: int) -> DesignResult:
+    """The result with ``robust``: its nominal error and the distribution of the error of
+    made cells (independent draws), beside the rms error it was refined against."""
+    from metainterface.inverse.tolerance import spread
+
+    d = r.design
+    check = Perturbation.draw(
+        d.n_asperities,
+        ROBUST_REPORT_SAMPLES,
+        seed + 1,
+        sigma_h=perturb.sigma_h,
+        sigma_gamma=perturb.sigma_gamma,
+        scale_sigma=perturb.scale_sigma,
+    )
+    s = spread(
+        d.gamma,
+        d.h,
+        d.settings,
+        r.model,
+        check,
+        target=(r.target.p_star, r.target.alpha),
+        linear=False,
+    )
+    stats = {
+        "sigma_h": perturb.sigma_h,
+        "sigma_gamma": perturb.sigma_gamma,
+        "scale_sigma": perturb.scale_sigma,
+        "robust_samples": perturb.samples,
+        "error_nominal": r.error,
+        "error_rms_refined": r.robust_error_refined,
+        "error_median": float(np.median(s.errors)),
+        "error_p95": float(np.quantile(s.errors, 0.95)),
+        "check_samples": ROBUST_REPORT_SAMPLES,
+        "check_seed": seed + 1,
+    }
+    return replace(r, robust=stats)
+
+
+def _printable_record(r: DesignResult, radius_m: float | None) -> DesignResult:
+    q = dict(r.printable or {})
+    if radius_m is not None:
+        q["z_step_m"] = q["z_step"] * radius_m
+    q["z_step_units"] = "R"
+    return replace(r, printable=q)
 
 
 def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> DesignResult:
@@ -207,6 +333,8 @@ def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> Desi
         fallback=r.fallback,
         notes=notes,
         pressure=pressure,
+        printable=r.quantisation,
+        robust_error_refined=r.robust_error,
     )
 
 
@@ -354,6 +482,7 @@ def export(
     format: str | None = None,
     resolution: float | None = None,
     base: str | float = "1mm",
+    z_step: str | float | None = None,
 ) -> dict[str, Any]:
     """Write the design's surface for manufacture: STL (mm), 16-bit PNG/TIFF or NPY (m).
 
@@ -372,6 +501,11 @@ def export(
         Grid points per mm (default 64 per asperity pitch).
     base : str or float
         STL base plate thickness under the surface (default 1 mm).
+    z_step : str or float
+        A printer's layer height ('1um', or a plain number in units of R), at most
+        Delta_max: the asperities' height offsets are snapped to its multiples (a design
+        made with ``design(..., z_step=...)`` already sits on them; the sidecar records the
+        largest shift).
 
     Returns
     -------
@@ -384,10 +518,21 @@ def export(
     if resolution is not None:
         resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
     source = str(design) if isinstance(design, str | os.PathLike) else None
+    radius_m = parse_length(radius, option="radius")
+    step = None
+    if z_step is not None:
+        from metainterface.api.tolerance import length_in_r
+
+        step = length_in_r(z_step, radius_m, option="z_step", radius_option="radius")
+        if not 0 < step <= d.settings.delta_max:
+            raise MetainterfaceError(
+                f"z_step must be in (0, Delta_max = {d.settings.delta_max:g} R], got {step:g} R"
+            )
     return export_design(
         d,
         path,
-        radius=parse_length(radius, option="radius"),
+        z_step=step,
+        radius=radius_m,
         tiles=tiles,
         fmt=format,
         resolution=resolution,

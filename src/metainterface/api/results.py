@@ -24,8 +24,10 @@ if TYPE_CHECKING:
 #: Delta samples of a curve when none are asked for.
 CURVE_STEPS = 256
 #: Most points of a target curve stored in design.json (the full one goes to target.csv
-#: only when asked): enough to draw it, small whatever the size of the user's file.
-RECORD_POINTS = 256
+#: only when asked): small whatever the size of the user's file (~100 kB at most), yet
+#: the built-in and typical measured targets are kept whole, so errors measured later to
+#: the stored target (tolerance, validate) equal the one the design reported.
+RECORD_POINTS = 2048
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -150,7 +152,11 @@ class DesignResult:
     model: the forward model designed with. start: which start won (0 = the zero-shot
     prediction). fallback: the design came from the fallback multistart. notes: what the
     pipeline decided on the user's behalf. pressure: the peak-pressure check, when a limit
-    was given.
+    was given. robust (robust design): the errors designed for and the statistics of the
+    made cells: error_nominal, error_median, error_p95 (over independent draws) and
+    error_rms_refined (over the copies refined against); robust_error_refined the latter.
+    printable (a layer height): z_step [R] and the error before the snap, after it and
+    after the re-refine (``error`` is the last).
     """
 
     target: Target
@@ -164,6 +170,9 @@ class DesignResult:
     fallback: bool = False
     notes: tuple[str, ...] = ()
     pressure: PressureCheck | None = None
+    robust: dict[str, Any] | None = None
+    printable: dict[str, Any] | None = None
+    robust_error_refined: float | None = None
 
     @property
     def origin(self) -> str:
@@ -227,6 +236,8 @@ class DesignResult:
             "seconds": self.seconds,
             **({"notes": list(self.notes)} if self.notes else {}),
             **({"pressure_check": self.pressure.to_dict()} if self.pressure else {}),
+            **({"robust": self.robust} if self.robust else {}),
+            **({"printable": self.printable} if self.printable else {}),
         }
 
     def save(
@@ -241,10 +252,23 @@ class DesignResult:
 
     def __repr__(self) -> str:
         note = f", note: {self.notes[0]}" if self.notes else ""
+        made = ""
+        if self.robust:
+            made += (
+                f", robust: made cells median {_percent(self.robust['error_median'])}, "
+                f"p95 {_percent(self.robust['error_p95'])}"
+            )
+        if self.printable:
+            q = self.printable
+            made += (
+                f", on a {q['z_step']:.3g} R layer grid: {_percent(q['error_before_snap'])} "
+                f"-> snapped {_percent(q['error_after_snap'])} -> re-refined "
+                f"{_percent(q['error_after_refine'])}"
+            )
         return (
             f"DesignResult(target={self.target.name!r}, method={self.method!r}, "
             f"model={self.model.label!r}, error={_percent(self.error)}, "
-            f"zero-shot {_percent(self.initial_error)}, {self.seconds:.2f} s, "
+            f"zero-shot {_percent(self.initial_error)}, {self.seconds:.2f} s{made}, "
             f"design={self.design!r}{note})"
         )
 

@@ -22,6 +22,7 @@ COMMANDS: tuple[str, ...] = (
     "train",
     "evaluate",
     "export",
+    "tolerance",
     "validate",
     "reproduce",
     "view",

@@ -95,6 +95,31 @@ def register(sub: argparse._SubParsersAction) -> None:
     space.add_argument("--gamma-min", type=float, help="smallest shape exponent (1.8)")
     space.add_argument("--gamma-max", type=float, help="largest shape exponent (4.0)")
     space.add_argument("--delta-max", type=float, help="largest indentation in units of R (0.02)")
+    made = p.add_argument_group(
+        "manufacturing (lengths with a unit need --radius; a plain number is in units of R, "
+        "and Delta_max is 0.02 R)"
+    )
+    made.add_argument(
+        "--robust",
+        action="store_true",
+        help="design for the errors below: refine the mean error over --robust-samples "
+        "perturbed copies of each start; design.json keeps the nominal relative_error and "
+        "adds the made cells' median and p95",
+    )
+    made.add_argument("--sigma-h", metavar="LENGTH", help="height error (one sd), e.g. 1um")
+    made.add_argument("--sigma-gamma", type=float, default=0.0, help="shape-exponent error")
+    made.add_argument(
+        "--scale-sigma", type=float, default=0.0, help="relative error of the heights' scale"
+    )
+    made.add_argument(
+        "--robust-samples", type=int, default=16, help="perturbed copies per start (16)"
+    )
+    made.add_argument(
+        "--z-step",
+        metavar="LENGTH",
+        help="printer layer height, e.g. 1um: heights snapped to its multiples, the shapes "
+        "re-refined; the error before and after is reported",
+    )
     p.add_argument(
         "--max-pressure",
         help="peak contact pressure limit: p/E* (number) or a stress with --modulus",
@@ -156,6 +181,7 @@ def run(args: argparse.Namespace) -> int:
         settings=_settings(args),
         meta=_command(args),
         full_target=args.full_target,
+        **_manufacturing(args),
     )
     if args.compare:
         if args.html:
@@ -177,11 +203,29 @@ def run(args: argparse.Namespace) -> int:
         if r.pressure is not None:
             print(f"{r.target.name} ({r.method}): {r.pressure.summary()}")
     width = max(len("target"), *(len(r.target.name) for r in results)) + 2
-    print(f"{'target':<{width}}{'method':<12}{'zero-shot':>11}{'error':>11}{'seconds':>9}")
+    head = f"{'target':<{width}}{'method':<12}{'zero-shot':>11}{'error':>11}{'seconds':>9}"
+    if args.robust:
+        head += f"{'made p50':>11}{'made p95':>11}"
+    if args.z_step is not None:
+        head += f"{'unsnapped':>11}{'snapped':>11}"
+    print(head)
     for r in results:
-        print(
+        line = (
             f"{r.target.name:<{width}}{r.method:<12}{100 * r.initial_error:>9.3g} %"
             f"{100 * r.error:>9.3g} %{r.seconds:>9.2f}"
+        )
+        if r.robust:
+            line += f"{100 * r.robust['error_median']:>9.3g} %{100 * r.robust['error_p95']:>9.3g} %"
+        if r.printable:
+            q = r.printable
+            line += f"{100 * q['error_before_snap']:>9.3g} %{100 * q['error_after_snap']:>9.3g} %"
+        print(line)
+    if args.robust:
+        print("error: the nominal design's; made p50/p95: of cells made with the errors given")
+    if args.z_step is not None:
+        print(
+            "unsnapped/snapped: before the snap to the layer grid and right after it; error: "
+            "after the shapes were re-refined"
         )
     if args.html:  # one page per design folder
         from pathlib import Path
@@ -192,6 +236,55 @@ def run(args: argparse.Namespace) -> int:
             print(f"{page}: interactive view, opens in a browser")
     print(f"written to {args.out}")
     return 0
+
+
+def _manufacturing(args: argparse.Namespace) -> dict:
+    """The robust-design and layer options, lengths in units of R (errors name the options)."""
+    import metainterface as mi
+    from metainterface.api.tolerance import length_in_r
+    from metainterface.physical import parse_length
+
+    radius = None if args.radius is None else parse_length(args.radius, option="--radius")
+    out: dict = {}
+    if args.z_step is not None:
+        out["z_step"] = length_in_r(
+            args.z_step, radius, option="--z-step", radius_option="--radius"
+        )
+        delta_max = 0.02 if args.delta_max is None else args.delta_max
+        if not 0 < out["z_step"] <= delta_max:
+            raise mi.MetainterfaceError(
+                f"--z-step must be in (0, Delta_max = {delta_max:g} R], got {out['z_step']:g} R"
+            )
+    given = args.sigma_h is not None or args.sigma_gamma or args.scale_sigma
+    if not args.robust:
+        if given:
+            raise mi.MetainterfaceError("--sigma-h, --sigma-gamma, --scale-sigma need --robust")
+        return out
+    sigma_h = 0.0
+    if args.sigma_h is not None:
+        sigma_h = length_in_r(args.sigma_h, radius, option="--sigma-h", radius_option="--radius")
+    checks = (
+        ("--sigma-gamma", args.sigma_gamma, 0.0, None),
+        ("--scale-sigma", args.scale_sigma, 0.0, 0.5),
+    )
+    for name, value, low, high in checks:
+        if not (value >= low and (high is None or value <= high) and value < float("inf")):
+            span = f"[{low:g}, {'inf' if high is None else f'{high:g}'}]"
+            raise mi.MetainterfaceError(f"{name} must be a finite number in {span}, got {value}")
+    if not (1 <= args.robust_samples <= 1024):
+        raise mi.MetainterfaceError(
+            f"--robust-samples must be a whole number in [1, 1024], got {args.robust_samples}"
+        )
+    if sigma_h == args.sigma_gamma == args.scale_sigma == 0.0:
+        raise mi.MetainterfaceError("--robust needs --sigma-h, --sigma-gamma or --scale-sigma > 0")
+    out.update(
+        robust=True,
+        sigma_h=sigma_h,
+        sigma_gamma=args.sigma_gamma,
+        scale_sigma=args.scale_sigma,
+        robust_samples=args.robust_samples,
+    )
+    return out
 
 
 def _settings(args: argparse.Namespace):

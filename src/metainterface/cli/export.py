@@ -33,6 +33,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--base", default="1mm", help="STL base plate thickness under the surface (default 1mm)"
     )
+    p.add_argument(
+        "--z-step",
+        metavar="LENGTH",
+        help="printer layer height, e.g. 1um: the asperities' heights snapped to its multiples",
+    )
     p.set_defaults(func=run)
 
 
@@ -59,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
         format=args.format,
         resolution=resolution,
         base=parse_length(args.base, option="--base"),
+        z_step=_z_step(args),
     )
     nx, ny = rec["tiles"]
     size = f"{rec['size_m'][0] * 1e3:.4g} x {rec['size_m'][1] * 1e3:.4g} mm"
@@ -67,5 +73,30 @@ def run(args: argparse.Namespace) -> int:
         ex = rec["extents_mm"]
         size = f"{ex[0]:.4g} x {ex[1]:.4g} x {ex[2]:.4g} mm"
         detail += f", {rec['triangles']} triangles, watertight"
+    if "z_step" in rec:
+        z = rec["z_step"]
+        detail += (
+            f", heights on a {z['z_step_m'] * 1e6:.3g} um grid "
+            f"(largest shift {z['largest_shift_m'] * 1e6:.3g} um)"
+        )
     print(f"{args.out}: {rec['format']} of {nx}x{ny} cells, {size}, {detail}")
     return 0
+
+
+def _z_step(args: argparse.Namespace) -> float | None:
+    """--z-step in units of R (errors name the option)."""
+    if args.z_step is None:
+        return None
+    import metainterface as mi
+    from metainterface.api.tolerance import length_in_r
+    from metainterface.physical import parse_length
+
+    radius = parse_length(args.radius, option="--radius")
+    step = length_in_r(args.z_step, radius, option="--z-step", radius_option="--radius")
+    delta_max = mi.Design.load(args.design).settings.delta_max
+    if not 0 < step <= delta_max:
+        raise mi.MetainterfaceError(
+            f"--z-step must be in (0, Delta_max = {delta_max * radius * 1e6:.4g} um], "
+            f"got {step * radius * 1e6:.4g} um"
+        )
+    return step

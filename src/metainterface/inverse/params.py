@@ -40,6 +40,10 @@ class Parameterisation:
         if g is not None and not (isinstance(g, int | float) and 1.0 < g < float("inf")):
             raise MetainterfaceError(f"fixed_gamma must be a number > 1, got {g!r}")
 
+    def rows(self, index: Tensor) -> Parameterisation:
+        """The parameterisation of some rows of the batch (the same here: nothing per row)."""
+        return self
+
     def size(self, n_asperities: int) -> int:
         """D, the number of unbounded parameters of an N-asperity design."""
         return n_asperities - 1 if self.fixed_gamma is not None else 2 * n_asperities - 1
@@ -96,3 +100,53 @@ class Parameterisation:
 FULL = Parameterisation()
 #: The Hertz-only baseline: every asperity a paraboloid (gamma = 2), heights only.
 HERTZ = Parameterisation(fixed_gamma=2.0)
+
+
+@dataclass(frozen=True)
+class FixedHeights(Parameterisation):
+    """gamma free, every height fixed: the re-refinement of a design whose heights were
+    snapped to a printer's layer grid (D = N).
+
+    h: (B, N) the fixed heights [units of R], one row per row of the batch, in the order
+    the asperities keep (no re-sorting: the heights do not move, and a placed model keeps
+    asperity k in lattice cell k).
+    """
+
+    h: Tensor | None = None
+
+    def __post_init__(self) -> None:
+        if self.h is None or self.h.dim() != 2:
+            raise MetainterfaceError("FixedHeights needs the (B, N) heights")
+
+    def rows(self, index: Tensor) -> FixedHeights:
+        return FixedHeights(h=self.h[index])
+
+    def size(self, n_asperities: int) -> int:
+        return n_asperities
+
+    def _heights(self, count: int) -> Tensor:
+        # the Levenberg-Marquardt Jacobian evaluates each row several times, rows repeated
+        # in place (``refine.residuals``): the heights follow
+        b = self.h.shape[0]
+        return self.h if count == b else self.h.repeat_interleave(count // b, 0)
+
+    def to_design(self, raw, settings, *, sort=True):
+        span = settings.gamma_max - settings.gamma_min
+        gamma = settings.gamma_min + span * torch.sigmoid(raw)
+        return gamma, self._heights(raw.shape[0]).to(raw.dtype)
+
+    def from_design(self, gamma, h, settings):
+        u = ((gamma - settings.gamma_min) / (settings.gamma_max - settings.gamma_min)).clamp(
+            START_MARGIN, 1 - START_MARGIN
+        )
+        return torch.logit(u).to(DTYPE)
+
+    def random(self, count, settings, generator):
+        raise MetainterfaceError("FixedHeights refines given designs; it draws no starts")
+
+
+def snap_heights(h: Tensor, step: float) -> Tensor:
+    """Heights (B, N) anchored (min -> 0) and rounded to the nearest multiple of ``step``
+    [units of R]: a printer's layer grid."""
+    h = h - h.min(dim=-1, keepdim=True).values
+    return torch.round(h / step) * step

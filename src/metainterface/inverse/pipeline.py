@@ -22,13 +22,22 @@ import torch
 from torch import Tensor
 
 from metainterface.errors import MetainterfaceError
-from metainterface.inverse.params import DTYPE, FULL, HERTZ, Parameterisation
+from metainterface.inverse.params import (
+    DTYPE,
+    FULL,
+    HERTZ,
+    FixedHeights,
+    Parameterisation,
+    snap_heights,
+)
+from metainterface.inverse.perturb import Perturbation
 from metainterface.inverse.refine import (
     RefineSettings,
     TargetGrid,
     polish,
     refine,
     relative_error,
+    robust_error,
 )
 from metainterface.inverse.targets import Target, target_features
 from metainterface.physics.cell import CellSettings
@@ -59,6 +68,10 @@ class DesignResult:
     start: int = 0  # which start won: 0 = the zero-shot prediction (surrogate) or first start
     fallback: bool = False  # the design came from the surrogate method's fallback multistart
     notes: tuple[str, ...] = ()  # what the pipeline decided for the user (e.g. no surrogate)
+    # robust design: the rms relative error over the perturbed copies refined against
+    robust_error: float | None = None
+    # printable heights: errors before the snap to the layer grid, after it, and the step
+    quantisation: dict | None = None
 
 
 def random_starts(
@@ -137,6 +150,8 @@ def design(
     hedge: int = 0,
     fallback: int = 0,
     fallback_error: float = 0.02,
+    perturb: Perturbation | None = None,
+    z_step: float | None = None,
 ) -> list[DesignResult]:
     """Design one cell per target with ``method``; returns one result per target.
 
@@ -159,6 +174,17 @@ def design(
     ``settings`` is the cell (N, gamma bounds, Delta_max). The surrogate method uses the
     shipped model where it was trained for that cell; for another cell it warns and runs
     the multistart instead (``DesignResult.notes`` says so).
+
+    ``perturb`` (robust design): every start is refined against the mean loss of its K
+    perturbed copies (:class:`~metainterface.inverse.perturb.Perturbation`, the same K
+    draws for every start and step), in the same batch as the starts; the winner is the
+    start with the smallest rms error over the copies (``robust_error``), and ``error``
+    stays the nominal design's.
+
+    ``z_step`` (printable heights, units of R): each winner's heights are snapped to
+    multiples of it (anchored at 0), then its gammas re-refined with the heights fixed
+    (:class:`~metainterface.inverse.params.FixedHeights`, the polish on the exact law);
+    ``quantisation`` records the error before the snap, after it and after the re-refine.
     """
     model = get_model(model)
     common = dict(
@@ -170,6 +196,7 @@ def design(
         refine_settings=refine_settings,
         extra_loss=extra_loss,
         model=model,
+        perturb=perturb,
     )
     method, notes = _usable_method(method, settings, model_path)
     if notes:
@@ -179,18 +206,91 @@ def design(
     if notes:
         results = [replace(r, notes=notes) for r in results]
     missed = [i for i, r in enumerate(results) if r.error > fallback_error]
-    if method != "surrogate" or fallback <= 0 or not missed:
-        return results
-    t0 = time.perf_counter()
-    common.update(settings=results[0].settings, starts=fallback)
-    alt = _design([targets[i] for i in missed], "multistart", hedge=0, **common)
-    extra = (time.perf_counter() - t0) / len(missed)
-    for i, a in zip(missed, alt, strict=True):
-        r = results[i]
-        if a.error < r.error:
-            r = replace(r, gamma=a.gamma, h=a.h, error=a.error, start=a.start, fallback=True)
-        results[i] = replace(r, seconds=r.seconds + extra)
+    if method == "surrogate" and fallback > 0 and missed:
+        t0 = time.perf_counter()
+        common.update(settings=results[0].settings, starts=fallback)
+        alt = _design([targets[i] for i in missed], "multistart", hedge=0, **common)
+        extra = (time.perf_counter() - t0) / len(missed)
+        for i, a in zip(missed, alt, strict=True):
+            r = results[i]
+            if _score(a) < _score(r):
+                r = replace(
+                    r,
+                    gamma=a.gamma,
+                    h=a.h,
+                    error=a.error,
+                    robust_error=a.robust_error,
+                    start=a.start,
+                    fallback=True,
+                )
+            results[i] = replace(r, seconds=r.seconds + extra)
+    if z_step is not None:
+        results = printable(
+            results, z_step, refine_settings or RefineSettings(), extra_loss, model, perturb
+        )
     return results
+
+
+def _score(r: DesignResult) -> float:
+    """What picks the better of two designs: the robust error when designing for it."""
+    return r.error if r.robust_error is None else r.robust_error
+
+
+def printable(
+    results: list[DesignResult],
+    step: float,
+    rs: RefineSettings,
+    extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None,
+    model: ForwardModel,
+    perturb: Perturbation | None = None,
+) -> list[DesignResult]:
+    """The designs with heights on multiples of ``step`` [units of R] and their gammas
+    re-refined (all targets in one batch); the better of the snapped and the re-refined
+    design is kept, by the robust error when ``perturb`` is given."""
+    t0 = time.perf_counter()
+    settings = results[0].settings
+    grid = TargetGrid.from_curves(
+        [(r.target.p_star, r.target.alpha) for r in results], rs.grid_points
+    )
+    gamma = torch.as_tensor(np.array([r.gamma for r in results]), dtype=DTYPE)
+    h = snap_heights(torch.as_tensor(np.array([r.h for r in results]), dtype=DTYPE), step)
+    param = FixedHeights(h=h)
+    snapped = relative_error(gamma, h, settings, grid, model)
+    raw = polish(
+        param.from_design(gamma, h, settings), settings, grid, rs, param, extra_loss, model, perturb
+    )
+    g_new, _ = param.to_design(raw, settings)
+    after = relative_error(g_new, h, settings, grid, model)
+    if perturb is None:
+        score_old, score_new = snapped, after
+    else:
+        score_old = robust_error(gamma, h, settings, grid, perturb, model)
+        score_new = robust_error(g_new, h, settings, grid, perturb, model)
+    better = score_new < score_old
+    g_best = torch.where(better[:, None], g_new, gamma)
+    err = torch.where(better, after, snapped)
+    rob = torch.where(better, score_new, score_old) if perturb is not None else None
+    extra = (time.perf_counter() - t0) / len(results)
+    out = []
+    for i, r in enumerate(results):
+        q = {
+            "z_step": step,
+            "error_before_snap": r.error,
+            "error_after_snap": float(snapped[i]),
+            "error_after_refine": float(err[i]),
+        }
+        out.append(
+            replace(
+                r,
+                gamma=g_best[i].numpy().copy(),
+                h=h[i].numpy().copy(),
+                error=float(err[i]),
+                robust_error=None if rob is None else float(rob[i]),
+                quantisation=q,
+                seconds=r.seconds + extra,
+            )
+        )
+    return out
 
 
 def _design(
@@ -206,6 +306,7 @@ def _design(
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None,
     model: ForwardModel,
     hedge: int,
+    perturb: Perturbation | None = None,
 ) -> list[DesignResult]:
     if method not in METHODS:
         raise MetainterfaceError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
@@ -239,25 +340,35 @@ def _design(
     err0 = relative_error(gamma0, h0, settings, rows, model)
     raw = param.from_design(gamma0, h0, settings)
     if refine_designs:
-        raw = refine(raw, settings, rows, refine_settings, param, extra_loss, model)
+        raw = refine(raw, settings, rows, refine_settings, param, extra_loss, model, perturb)
     gamma, h = param.to_design(raw.detach(), settings)
     err = relative_error(gamma, h, settings, rows, model)
+
+    def score(g: Tensor, hh: Tensor, grid: TargetGrid, nominal: Tensor) -> Tensor:
+        # what ranks the starts: the nominal error, or the robust one when designing for it
+        return nominal if perturb is None else robust_error(g, hh, settings, grid, perturb, model)
+
+    rank = score(gamma, h, rows, err)
     offset = torch.arange(len(targets))[:, None] * per_target
     if refine_designs and refine_settings.polish_iterations > 0:
         # The early stops cut the search short on every row; the best few of each target get
         # to finish (rows close before the polish can swap places after it).
         top = min(POLISH_ROWS, per_target)
-        kept_rows = err.view(len(targets), per_target).topk(top, largest=False).indices + offset
+        kept_rows = rank.view(len(targets), per_target).topk(top, largest=False).indices + offset
         kept_rows = kept_rows.reshape(-1)
         kept = rows.rows(kept_rows)
-        raw_w = polish(raw[kept_rows], settings, kept, refine_settings, param, extra_loss, model)
+        raw_w = polish(
+            raw[kept_rows], settings, kept, refine_settings, param, extra_loss, model, perturb
+        )
         g_w, h_w = param.to_design(raw_w, settings)
         err_w = relative_error(g_w, h_w, settings, kept, model)
-        better = err_w < err[kept_rows]
+        rank_w = score(g_w, h_w, kept, err_w)
+        better = rank_w < rank[kept_rows]
         gamma[kept_rows] = torch.where(better[:, None], g_w, gamma[kept_rows])
         h[kept_rows] = torch.where(better[:, None], h_w, h[kept_rows])
         err[kept_rows] = torch.where(better, err_w, err[kept_rows])
-    winner = err.view(len(targets), per_target).argmin(-1)
+        rank[kept_rows] = torch.where(better, rank_w, rank[kept_rows])
+    winner = rank.view(len(targets), per_target).argmin(-1)
     best = winner + offset[:, 0]
     err0 = err0.view(len(targets), per_target)
     # the zero-shot error of the surrogate is its own row's; baselines report their best start
@@ -275,6 +386,7 @@ def _design(
             settings=settings,
             model=model,
             start=int(winner[i]),
+            robust_error=None if perturb is None else float(rank[b]),
         )
         for i, (t, b) in enumerate(zip(targets, best.tolist(), strict=True))
     ]

@@ -25,6 +25,7 @@ from torch import Tensor
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import lbfgs, levmar
 from metainterface.inverse.params import DTYPE, FULL, Parameterisation
+from metainterface.inverse.perturb import Perturbation, loaded
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import at_delta, interp_weights, relative_l2, solve_delta
 from metainterface.physics.models import ForwardModel, get_model
@@ -253,6 +254,30 @@ def relative_error(
         return relative_l2(alpha, target.alpha)
 
 
+def robust_error(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    target: TargetGrid,
+    perturb: Perturbation,
+    model: ForwardModel | None = None,
+) -> Tensor:
+    """The robust design's objective as an error (B,): sqrt((e_0^2 + mean_k e_k^2) / 2),
+    e_0 the design's own :func:`relative_error` and e_k its K perturbed copies'.
+
+    The made copies are loaded past Delta_max where they need it (:func:`loaded`); the
+    nominal term, on the design's own Delta range as ``design`` measures it, keeps a design
+    whose own range stops short of the target from winning on copies that reach it only
+    that way (in the loss its points beyond its reach count in full, not at the
+    undershoot weight)."""
+    k = perturb.samples
+    g_k, h_k = perturb.apply(gamma, h)
+    rows = target.rows(torch.arange(gamma.shape[0]).repeat_interleave(k))
+    made = relative_error(g_k, h_k, loaded(settings), rows, model).view(-1, k)
+    nominal = relative_error(gamma, h, settings, target, model)
+    return (0.5 * (nominal**2 + made.pow(2).mean(-1))).sqrt()
+
+
 def polish(
     raw: Tensor,
     settings: CellSettings,
@@ -261,18 +286,22 @@ def polish(
     param: Parameterisation = FULL,
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
     model: ForwardModel | None = None,
+    perturb: Perturbation | None = None,
 ) -> Tensor:
     """The polish after the stages: Levenberg-Marquardt on the exact law if
-    ``rs.polish_method`` says so and the loss is a sum of squares (no ``extra_loss``), then
-    L-BFGS (``RefineSettings.polishing``) on the rows it left above the design tolerance;
-    else L-BFGS alone. Returns the polished raw parameters (B, D)."""
+    ``rs.polish_method`` says so and the loss is a sum of squares (no ``extra_loss``, no
+    ``perturb``), then L-BFGS (``RefineSettings.polishing``) on the rows it left above the
+    design tolerance; else L-BFGS alone. Returns the polished raw parameters (B, D)."""
     rs = rs or RefineSettings()
-    if rs.polish_method == "lbfgs" or extra_loss is not None or not rs.polish_exact:
-        return refine(raw, settings, target, rs.polishing(), param, extra_loss, model)
+    lm = rs.polish_method == "levmar" and rs.polish_exact
+    if not lm or extra_loss is not None or perturb is not None:
+        return refine(raw, settings, target, rs.polishing(), param, extra_loss, model, perturb)
     model = get_model(model)
 
     def fun(z: Tensor, idx: Tensor) -> tuple[Tensor, Tensor]:
-        return residuals(z, settings, target.rows(idx), rs.undershoot_weight, model, param)
+        return residuals(
+            z, settings, target.rows(idx), rs.undershoot_weight, model, param.rows(idx)
+        )
 
     res = levmar.least_squares(
         fun,
@@ -291,10 +320,11 @@ def polish(
     left = (res.loss > rs.tol_error**2).nonzero(as_tuple=True)[0]
     if left.shape[0]:
         rows = target.rows(left)
-        y = refine(raw[left], settings, rows, rs.polishing(), param, None, model)
+        sub = param.rows(left)
+        y = refine(raw[left], settings, rows, rs.polishing(), sub, None, model)
         with torch.no_grad():
             loss = masked_loss(
-                *param.to_design(y, settings, sort=model.placed),
+                *sub.to_design(y, settings, sort=model.placed),
                 settings,
                 rows,
                 None,
@@ -314,20 +344,33 @@ def refine(
     param: Parameterisation = FULL,
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
     model: ForwardModel | None = None,
+    perturb: Perturbation | None = None,
 ) -> Tensor:
     """Run the stages on a batch of unbounded parameters (B, D); each row is its own problem
     against the matching row of ``target``. ``extra_loss(gamma, h, settings) -> (B,)`` is
-    added if given (e.g. a pressure limit). Returns the refined raw parameters."""
+    added if given (e.g. a pressure limit). With ``perturb`` (robust design) a row's loss is
+    the mean of the design's loss and the mean loss of its K perturbed copies (see
+    :func:`robust_error`), all rows' copies in one batch, the same K draws throughout
+    (common random numbers: a smooth objective). Returns the refined raw parameters."""
     rs = rs or RefineSettings()
     model = get_model(model)
     x = raw.detach().to(DTYPE)
     for kappa in rs.kappas():
 
         def fun(z: Tensor, idx: Tensor, kappa: float | None = kappa) -> Tensor:
-            gamma, h = param.to_design(z, settings, sort=model.placed)
-            loss = masked_loss(
-                gamma, h, settings, target.rows(idx), kappa, rs.undershoot_weight, model
-            )
+            gamma, h = param.rows(idx).to_design(z, settings, sort=model.placed)
+            rows = target.rows(idx)
+            if perturb is None:
+                loss = masked_loss(gamma, h, settings, rows, kappa, rs.undershoot_weight, model)
+            else:
+                # the nominal's points beyond its reach count in full (see robust_error)
+                loss = masked_loss(gamma, h, settings, rows, kappa, 1.0, model)
+                k = perturb.samples
+                g_k, h_k = perturb.apply(gamma, h)
+                rows = rows.rows(torch.arange(len(idx)).repeat_interleave(k))
+                wide = loaded(settings)  # made cells load past Delta_max where they need it
+                made = masked_loss(g_k, h_k, wide, rows, kappa, rs.undershoot_weight, model)
+                loss = 0.5 * (loss + made.view(-1, k).mean(-1))
             return loss if extra_loss is None else loss + extra_loss(gamma, h, settings)
 
         x = lbfgs.minimize(

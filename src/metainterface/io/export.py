@@ -284,14 +284,20 @@ def export_design(
     resolution: float | None = None,
     base: float = 1e-3,
     source: str | None = None,
+    z_step: float | None = None,
 ) -> dict[str, Any]:
     """Write the design's surface to ``out`` (and ``out.json``); returns the sidecar record.
 
     radius: R [m]; tiles: (nx, ny); fmt: stl|png|tiff|npy (default from the suffix);
     resolution: grid points per mm (default 64 per asperity pitch); base: STL plate
-    thickness [m]; source: the design file name, for the record.
+    thickness [m]; source: the design file name, for the record; z_step: a printer's layer
+    height [units of R]: the asperities' height offsets are snapped to its multiples first
+    (the largest shift is recorded; a design made with the same z_step moves by 0).
     """
     out = Path(out)
+    snap = None
+    if z_step is not None:
+        design, snap = _snap(design, z_step, radius)
     fmt = format_for(out, fmt)
     tiles = parse_tiles(tiles)
     grid = None if resolution is None else grid_for_resolution(design, radius, resolution)
@@ -309,6 +315,8 @@ def export_design(
         "size_m": [size[0], size[1]],
         "layout": "row i at y = i * pixel_size_m, column j at x = j * pixel_size_m; tips up",
     }
+    if snap is not None:
+        record["z_step"] = snap
     if fmt == "npy":
         buf = io.BytesIO()
         np.save(buf, patch.heights)
@@ -343,9 +351,25 @@ def export_design(
         format=fmt,
         resolution=resolution,
         base_m=float(base) if fmt == "stl" else None,
+        z_step=z_step,
     )
     write_text(sidecar_path(out), json.dumps(record, indent=2) + "\n")
     return record
+
+
+def _snap(design: Design, step: float, radius: float) -> tuple[Design, dict[str, Any]]:
+    """The design with its height offsets (anchored at 0) on multiples of ``step`` [R]."""
+    from dataclasses import replace
+
+    h = design.h - design.h.min()
+    snapped = np.round(h / step) * step
+    scale = _scale(design, radius)
+    record = {
+        "z_step_m": step * scale,
+        "levels": [int(v) for v in np.round(h / step)],
+        "largest_shift_m": float(np.abs(snapped - h).max() * scale),
+    }
+    return replace(design, h=snapped), record
 
 
 def sidecar_path(out: str | os.PathLike[str]) -> Path:
