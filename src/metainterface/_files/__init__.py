@@ -4,12 +4,19 @@ They know nothing of the domain (no physics, no designs), so the engine can chec
 stream results without importing the format layer (``metainterface.io``) above it.
 """
 
-from metainterface._files.atomic import atomic_open, ensure_parent, write_bytes, write_text
+from metainterface._files.atomic import (
+    atomic_open,
+    atomic_path,
+    ensure_parent,
+    write_bytes,
+    write_text,
+)
 from metainterface._files.columns import read_columns, write_columns
 from metainterface._files.provenance import csv_header, provenance
 
 __all__ = [
     "atomic_open",
+    "atomic_path",
     "csv_header",
     "ensure_parent",
     "provenance",

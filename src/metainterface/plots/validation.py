@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -18,9 +18,12 @@ def plot_validation(
     *,
     target: tuple[np.ndarray, np.ndarray] | None = None,
     title: str | None = None,
+    fields: Any = None,
 ) -> Figure:
     """Three panels: alpha(P*) (target, model, BEM), the cell's height map, p/E* at the
-    largest load. target: optional (p_star, alpha) arrays of the design's target curve."""
+    largest load. target: optional (p_star, alpha) arrays of the design's target curve.
+    fields: the result's fields file as an xarray Dataset (``metainterface.io.fields``):
+    the pressure panel then shows what the file holds, in its coordinates and units."""
     fig = new_figure(width=13.0, height=4.0)
     ax_c, ax_h, ax_p = fig.subplots(1, 3)
     p_top = float(result.p_star[-1])
@@ -67,8 +70,17 @@ def plot_validation(
     ax_h.set(xlabel="x / R", ylabel="y / R", title="topography")
     fig.colorbar(im, ax=ax_h, label="z / R", shrink=0.85, extend="min")
 
-    im = ax_p.imshow(result.pressure, origin="lower", extent=extent, cmap="magma")
-    ax_p.set(xlabel="x / R", ylabel="y / R", title=rf"$p/E^*$ at $P^* = {p_top:.3g}$")
+    pressure, labels = result.pressure, ("x / R", "y / R")
+    if fields is not None:
+        last = fields["pressure"].isel(load=-1)
+        pressure, p_top = np.asarray(last.values), float(last["p_star"])
+        x, y = np.asarray(fields["x"].values), np.asarray(fields["y"].values)
+        step = x[1] - x[0]  # pixel edges: the cell is periodic, grid point i at i * step
+        extent = (float(x[0]), float(x[-1] + step), float(y[0]), float(y[-1] + step))
+        units = fields["x"].attrs.get("units", "R")
+        labels = ("x / R", "y / R") if units == "R" else (f"x [{units}]", f"y [{units}]")
+    im = ax_p.imshow(pressure, origin="lower", extent=extent, cmap="magma")
+    ax_p.set(xlabel=labels[0], ylabel=labels[1], title=rf"$p/E^*$ at $P^* = {p_top:.3g}$")
     fig.colorbar(im, ax=ax_p, label=r"$p/E^*$", shrink=0.85)
     if title:
         fig.suptitle(title, fontsize=9)
