@@ -368,7 +368,7 @@ def validate_many(
     *,
     grid: int | None = None,
     loads: int | Sequence[float] | np.ndarray = DEFAULT_LOADS,
-    jobs: int = 1,
+    jobs: int | None = 1,
     model: str | ForwardModel | None = None,
     tolerance: float = TOLERANCE,
     max_iter: int = MAX_ITER,
@@ -394,7 +394,8 @@ def validate_many(
     grid, loads, model, tolerance, max_iter :
         As in ``validate``, for every design.
     jobs : int
-        Local processes (default 1: in this process), or the workers of ``scheduler="local"``.
+        Local processes (default 1: in this process; None: the cores), or the workers of
+        ``scheduler="local"``.
     figures, fields : bool
         Also write validation.png / fields.nc for every design.
     chunks : int
@@ -426,7 +427,7 @@ def validate_many(
     the next run.
     """
     require_tamaas()
-    jobs = check_jobs(jobs)
+    jobs = available_cpus() if jobs is None else check_jobs(jobs)
     chunks = _checks.whole("chunks", chunks, low=1, high=10_000)
     retries = _checks.whole("retries", retries, low=0, high=100)
     if fields:
