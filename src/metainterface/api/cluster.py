@@ -31,11 +31,13 @@ def require_dask() -> ModuleType:
 
 
 def check_scheduler(scheduler: str) -> str:
-    """``"local"`` or a scheduler address such as ``tcp://host:8786``."""
+    """``"local"`` or a scheduler address such as ``tcp://host:8786``, with Dask installed
+    (checked before any work starts)."""
     if not isinstance(scheduler, str) or not (scheduler == "local" or "://" in scheduler):
         raise MetainterfaceError(
             f"scheduler must be 'local' or an address like tcp://HOST:PORT, got {scheduler!r}"
         )
+    require_dask()
     return scheduler
 
 
