@@ -484,11 +484,7 @@ def validate_many(
     failed: set[int] = set()
     n_chunks = {d: owner.count(d) for d in range(len(todo))}
 
-    bar = None
-    if progress and todo:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=len(todo), desc="designs", unit="design")
+    bar: Any = None
 
     def on_done(i: int, part: LoadPath) -> None:
         d = owner[i]
@@ -524,21 +520,21 @@ def validate_many(
         if bar is not None:
             bar.update(1)
 
-    try:
-        with contextlib.ExitStack() as stack:
-            if scheduler is not None and tasks:
-                executor = stack.enter_context(dask_executor(scheduler, jobs))
-            stream(
-                solve_task,
-                tasks,
-                executor=executor,
-                jobs=jobs,
-                on_done=on_done,
-                on_error=on_error,
-                retries=retries,
-            )
-    finally:
-        if bar is not None:
-            bar.close()
+    with contextlib.ExitStack() as stack:
+        if scheduler is not None and tasks:  # joined first: a bad address fails before the bar
+            executor = stack.enter_context(dask_executor(scheduler, jobs))
+        if progress and todo:
+            from tqdm.auto import tqdm
+
+            bar = stack.enter_context(tqdm(total=len(todo), desc="designs", unit="design"))
+        stream(
+            solve_task,
+            tasks,
+            executor=executor,
+            jobs=jobs,
+            on_done=on_done,
+            on_error=on_error,
+            retries=retries,
+        )
     write_summary()
     return {n: summaries[n] for n, _ in items}

@@ -155,6 +155,7 @@ def run(args: argparse.Namespace) -> int:
 
 def run_many(args: argparse.Namespace) -> int:
     import metainterface as mi
+
     if args.p_max is not None:
         raise mi.MetainterfaceError("--p-max applies to one design; sweeps use --loads")
     designs = args.designs[0] if len(args.designs) == 1 else args.designs
