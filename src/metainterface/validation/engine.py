@@ -89,6 +89,8 @@ def stream(
     submitted again, at most ``retries`` times, then goes to ``on_error``. An exception from
     a callback stops the sweep (tasks not started are cancelled).
     """
+    if not tasks:
+        return
     if executor is None and jobs <= 1:
         for i, task in enumerate(tasks):
             try:
@@ -112,6 +114,7 @@ def stream(
                 "run the sweep again to resume"
             ) from None
 
+    finished = False
     try:
         for i in range(len(tasks)):
             submit(i)
@@ -147,11 +150,12 @@ def stream(
                 pool = local_pool(min(jobs, max(1, len(lost))))
             for i in sorted(set(lost)):
                 submit(i)
+        finished = True
     finally:
         for fut in pending:
             fut.cancel()
-        if own:
-            pool.shutdown(wait=True, cancel_futures=True)
+        if own:  # interrupted: do not wait for the running solves
+            pool.shutdown(wait=finished, cancel_futures=True)
 
 
 def _broken(pool: cf.ProcessPoolExecutor) -> bool:
