@@ -111,7 +111,7 @@ class Cluster:
                 **common,
             )
         )
-        with distributed.Client(self.address, timeout=30) as client:
+        with distributed.Client(self.address, timeout=30, set_as_default=False) as client:
             client.wait_for_workers(workers, timeout=60)
             # every worker imports the package once, side by side
             client.run(importlib.import_module, "metainterface.validation.engine")
@@ -179,7 +179,7 @@ def test_a_worker_killed_mid_task_has_its_task_retried(cluster, tmp_path):
     killed: list[int] = []
 
     def kill_a_busy_worker() -> None:
-        with distributed.Client(cluster.address, timeout=30) as client:
+        with distributed.Client(cluster.address, timeout=30, set_as_default=False) as client:
             pids = client.run(os.getpid)
             deadline = time.monotonic() + 60
             while time.monotonic() < deadline:
@@ -206,3 +206,5 @@ def test_a_worker_killed_mid_task_has_its_task_retried(cluster, tmp_path):
 
     assert solved(result) == solved(reference)
     pd.testing.assert_frame_equal(table(tmp_path / "sweep"), table(tmp_path / "reference"))
+    # the sweep's client never became Dask's default: the caller's settings are untouched
+    assert importlib.import_module("dask").config.get("scheduler", None) is None

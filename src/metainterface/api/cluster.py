@@ -47,7 +47,8 @@ def dask_executor(scheduler: str, workers: int | None = None) -> Iterator[Execut
 
     scheduler: ``"local"`` starts a ``LocalCluster`` of ``workers`` processes (one thread
     each: Tamaas holds the GIL) and stops it on exit; an address (``tcp://HOST:PORT``) joins
-    a running cluster, which is left running.
+    a running cluster, which is left running. The client is not made Dask's default, so the
+    caller's own Dask settings are left as they were.
     """
     check_scheduler(scheduler)
     distributed = require_dask()
@@ -60,9 +61,9 @@ def dask_executor(scheduler: str, workers: int | None = None) -> Iterator[Execut
                 processes=True,
                 dashboard_address=None,
             )
-            client = distributed.Client(cluster)
+            client = distributed.Client(cluster, set_as_default=False)
         else:
-            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
+            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError) as exc:
         if cluster is not None:
             cluster.close()

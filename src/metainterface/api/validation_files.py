@@ -322,10 +322,14 @@ def _staging(out: Path, name: str) -> Path:
 
 
 def _clear_leftovers(out: Path) -> None:
-    """Remove the hidden folders of a sweep that was killed while writing a design."""
+    """Remove what a sweep killed while writing leaves: hidden design folders, and the
+    temporary files of summary.csv / summary.json (``atomic_open``'s ``.NAME.*.tmp``)."""
     if out.is_dir():
         for leftover in [*out.glob(".*.partial-*"), *out.glob(".*.old-*")]:
             shutil.rmtree(leftover, ignore_errors=True)
+        for name in ("summary.csv", "summary.json"):
+            for tmp in out.glob(f".{name}.*.tmp"):
+                tmp.unlink(missing_ok=True)
 
 
 def summary_row(name: str, summary: dict[str, Any]) -> dict[str, Any]:
