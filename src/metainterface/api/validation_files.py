@@ -16,6 +16,7 @@ then renamed) and ``summary.csv``, one row per finished design, after each desig
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import csv
 import hashlib
@@ -486,7 +487,7 @@ def validate_many(
             owner.append(d)
     parts: dict[int, dict[int, LoadPath]] = {d: {} for d in range(len(todo))}
     failed: set[int] = set()
-    n_chunks = {d: owner.count(d) for d in range(len(todo))}
+    n_chunks = collections.Counter(owner)
 
     bar: Any = None
 

@@ -101,7 +101,7 @@ def stream(
             on_done(i, result)
         return
     own = executor is None
-    pool: cf.Executor = local_pool(min(jobs, max(1, len(tasks)))) if own else executor  # type: ignore[assignment]
+    pool = local_pool(min(jobs, len(tasks))) if executor is None else executor
     attempts = [0] * len(tasks)
     pending: dict[cf.Future[Any], int] = {}
 
@@ -147,7 +147,7 @@ def stream(
                 lost += list(pending.values())
                 pending.clear()
                 pool.shutdown(wait=False, cancel_futures=True)
-                pool = local_pool(min(jobs, max(1, len(lost))))
+                pool = local_pool(min(jobs, len(lost)))
             for i in sorted(set(lost)):
                 submit(i)
         finished = True
