@@ -74,11 +74,12 @@ def plot_validation(
     if fields is not None:
         last = fields["pressure"].isel(load=-1)
         pressure, p_top = np.asarray(last.values), float(last["p_star"])
-        x, y = np.asarray(fields["x"].values), np.asarray(fields["y"].values)
+        units = fields["x"].attrs.get("units", "R")
+        scale = 1e3 if units == "m" else 1.0  # metres are drawn in mm
+        x, y = scale * np.asarray(fields["x"].values), scale * np.asarray(fields["y"].values)
         step = x[1] - x[0]  # pixel edges: the cell is periodic, grid point i at i * step
         extent = (float(x[0]), float(x[-1] + step), float(y[0]), float(y[-1] + step))
-        units = fields["x"].attrs.get("units", "R")
-        labels = ("x / R", "y / R") if units == "R" else (f"x [{units}]", f"y [{units}]")
+        labels = ("x / R", "y / R") if units == "R" else ("x [mm]", "y [mm]")
     im = ax_p.imshow(pressure, origin="lower", extent=extent, cmap="magma")
     ax_p.set(xlabel=labels[0], ylabel=labels[1], title=rf"$p/E^*$ at $P^* = {p_top:.3g}$")
     fig.colorbar(im, ax=ax_p, label=r"$p/E^*$", shrink=0.85)
