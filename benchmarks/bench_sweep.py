@@ -4,7 +4,7 @@ Target (issue 19): 8 designs at 384 x 384 on 2 workers at least 1.8x faster than
 sweep on an idle 2-core machine. Wall times depend on what else runs on the cores: the load
 average is printed beside them. Prints a markdown table (benchmarks/results/sweep.md).
 
-Run: python benchmarks/bench_sweep.py [--designs 8] [--grid 384] [--loads 6] [--tasks 200]
+Run: python benchmarks/bench_sweep.py [--designs 8] [--grid 384] [--loads 4] [--tasks 200]
 """
 
 import argparse
@@ -54,7 +54,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--designs", type=int, default=8)
     ap.add_argument("--grid", type=int, default=384)
-    ap.add_argument("--loads", type=int, default=6)
+    ap.add_argument("--loads", type=int, default=4)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--tasks", type=int, default=200, help="no-op tasks for the overhead")
     args = ap.parse_args()
