@@ -163,6 +163,10 @@ def test_an_unreachable_scheduler_is_one_line(tmp_path, capsys):
         assert main(mi_args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in err[0]
+    assert main([*args, "--scheduler", "somehost:8786", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "scheduler must be 'local' or an address like tcp://" in err[0]
+    assert not out.exists()
 
 
 def test_a_worker_killed_mid_task_has_its_task_retried(cluster, tmp_path):
