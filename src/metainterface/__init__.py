@@ -22,7 +22,9 @@ Designing
 Curves and forward models
     curve, Curve, ForwardModel, Independent, Interacting, MODELS, get_model, register_model
 Checking and making
-    validate, validate_many, ValidationResult, write_result, export
+    validate, validate_many (sweeps on local processes, a Dask cluster or any
+    concurrent.futures.Executor; fields=True keeps the BEM fields), ValidationResult,
+    write_result, export
 Looking at a design
     view (an interactive, self-contained HTML page; the [view] extra), DesignResult.figure
 Manufacturing errors

@@ -4,7 +4,13 @@ They know nothing of the domain (no physics, no designs), so the engine can chec
 stream results without importing the format layer (``metainterface.io``) above it.
 """
 
-from metainterface._files.atomic import atomic_open, ensure_parent, write_bytes, write_text
+from metainterface._files.atomic import (
+    atomic_open,
+    atomic_path,
+    ensure_parent,
+    write_bytes,
+    write_text,
+)
 from metainterface._files.columns import read_columns, write_columns
 from metainterface._files.provenance import (
     compact_provenance,
@@ -15,6 +21,7 @@ from metainterface._files.provenance import (
 
 __all__ = [
     "atomic_open",
+    "atomic_path",
     "compact_provenance",
     "csv_header",
     "ensure_parent",

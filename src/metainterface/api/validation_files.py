@@ -4,23 +4,39 @@ Each design's folder holds
 
     bem.csv          p_star,alpha_bem,alpha_model,rel_err,p_max,alpha_bem_pixels
     asperities.csv   p_star, bem_k and model_k: contact area of asperity k / A_nom
+    models.csv       alpha and rel_err of every registered model (``validate`` only)
+    fields.nc        optional, pressure, gap and contact mask at every load (xarray/NetCDF4,
+                     ``metainterface.io.fields``); the figure's pressure panel reads it
     validation.png   optional, the paper's fig. 6 (``plots.plot_validation``)
     result.json      settings, summary errors and residuals; written last (completion mark)
+
+A sweep (``validate_many``) writes each design's folder whole (built under a hidden name,
+then renamed) and ``summary.csv``, one row per finished design, after each design.
 """
 
 from __future__ import annotations
 
+import collections
+import contextlib
+import csv
+import hashlib
+import io
 import json
 import os
+import shutil
+import uuid
 from collections.abc import Sequence
+from concurrent.futures import Executor
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from metainterface import _checks
-from metainterface._files import provenance, write_columns, write_text
+from metainterface._files import csv_header, provenance, write_columns, write_text
+from metainterface.api.cluster import check_scheduler, dask_executor
 from metainterface.errors import MetainterfaceError
+from metainterface.io.fields import FIELDS_FILE, open_fields, require_xarray, write_fields
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, get_model
 from metainterface.plots import plot_validation, save_figure
@@ -30,8 +46,8 @@ from metainterface.validation.bem import (
     LoadPath,
     available_cpus,
     require_tamaas,
-    run_tasks,
 )
+from metainterface.validation.engine import RETRIES, solve_task, stream
 from metainterface.validation.validate import (
     DEFAULT_LOADS,
     ValidationPlan,
@@ -55,6 +71,9 @@ def validate(
     jobs: int | None = 1,
     progress: bool = False,
     out: str | os.PathLike[str] | None = None,
+    fields: bool = False,
+    executor: Executor | None = None,
+    scheduler: str | None = None,
 ) -> ValidationResult:
     """Check a design against the boundary element method (Tamaas, the ``bem`` extra).
 
@@ -73,11 +92,21 @@ def validate(
     tolerance, max_iter :
         Polonsky-Keer-Rey tolerance (default 1e-11) and iteration limit.
     jobs : int
-        Processes; the load path is split into warm-started chunks (None: the cores).
+        The load path is split into ``jobs`` warm-started chunks, run on as many local
+        processes, or on ``executor`` / ``scheduler`` (None: the local cores).
     progress : bool
         Show a progress bar over the loads.
     out : path
-        Also write bem.csv, asperities.csv, models.csv, validation.png, result.json there.
+        Also write bem.csv, asperities.csv, models.csv, validation.png, result.json there
+        (and fields.nc with ``fields``).
+    fields : bool
+        Keep the pressure and gap fields of every load (``result.pressures``, ``.gaps``:
+        (K, M, M)); with ``out``, write them as fields.nc (the ``fields`` extra).
+    executor : concurrent.futures.Executor
+        Run the chunks there, e.g. ``dask.distributed.Client(...).get_executor()``.
+    scheduler : str
+        Or a Dask scheduler: ``"tcp://HOST:PORT"`` to join a running cluster, ``"local"`` to
+        start a LocalCluster of ``jobs`` processes (the ``distributed`` extra).
 
     Returns
     -------
@@ -86,6 +115,12 @@ def validate(
         (``max_rel_err_upper``, ``target_errors()``).
     """
     require_tamaas()
+    if fields and out is not None:
+        require_xarray()  # before the solve, not after it
+    if executor is not None and scheduler is not None:
+        raise MetainterfaceError("give executor or scheduler, not both")
+    if scheduler is not None:
+        check_scheduler(scheduler)
     name = str(design) if isinstance(design, str | os.PathLike) else "design"
     if not isinstance(design, Design):
         if not isinstance(design, str | os.PathLike):
@@ -107,13 +142,20 @@ def validate(
     )
     n_loads = len(plan.loads)
     jobs = min(available_cpus(), n_loads) if jobs is None else check_jobs(jobs)
-    if progress:
-        from tqdm.auto import tqdm
+    with contextlib.ExitStack() as stack:
+        if scheduler is not None:
+            executor = stack.enter_context(dask_executor(scheduler, jobs))
+        bar = None
+        if progress:
+            from tqdm.auto import tqdm
 
-        with tqdm(total=n_loads, desc="BEM loads", unit="load") as bar:
-            result = plan.solve(jobs, progress=bar.update)
-    else:
-        result = plan.solve(jobs)
+            bar = stack.enter_context(tqdm(total=n_loads, desc="BEM loads", unit="load"))
+        result = plan.solve(
+            jobs,
+            progress=None if bar is None else bar.update,
+            executor=executor,
+            fields=fields,
+        )
     if out is not None:
         write_result(result, out, command="validate", jobs=jobs)
         write_models(result, Path(out) / "models.csv")
@@ -156,9 +198,14 @@ def result_settings(result: ValidationResult, **extra: Any) -> dict[str, Any]:
 def write_result(
     result: ValidationResult, out_dir: str | os.PathLike[str], *, figure: bool = True, **extra: Any
 ) -> Path:
-    """Write bem.csv, asperities.csv, (validation.png) and result.json into ``out_dir``."""
+    """Write bem.csv, asperities.csv, (fields.nc, validation.png) and result.json into
+    ``out_dir``; fields.nc when the result carries fields (solved with ``fields=True``)."""
     out = Path(out_dir)
     settings = result_settings(result, **extra)
+    fields = None
+    if result.pressures is not None:
+        write_fields(result, out / FIELDS_FILE, **settings)
+        fields = open_fields(out / FIELDS_FILE)  # the figure shows what the file holds
     write_columns(
         out / "bem.csv",
         {
@@ -179,17 +226,17 @@ def write_result(
             cols[f"model_{k}"] = result.asperity_alpha_model[:, k]
     write_columns(out / "asperities.csv", cols, **settings)
     if figure:
-        fig = plot_validation(result, target=design_target(result.design), title=result.name)
+        fig = plot_validation(
+            result, target=design_target(result.design), title=result.name, fields=fields
+        )
         save_figure(fig, out / "validation.png", **settings)
+    request = validation_request(
+        result.design, result.grid, result.p_star, result.model, result.tolerance, result.max_iter
+    )
     record = {
-        "request": validation_request(
-            result.design,
-            result.grid,
-            result.p_star,
-            result.model,
-            result.tolerance,
-            result.max_iter,
-        ),
+        "request": request,
+        "request_hash": request_hash(request),
+        "fields": result.pressures is not None,
         "summary": result.summary(),
         "residual": [float(r) for r in result.residual],
         "seconds": [float(s) for s in result.seconds],
@@ -199,7 +246,24 @@ def write_result(
     return out
 
 
+def request_hash(request: dict[str, Any]) -> str:
+    """A short hash of a validation request (JSON with sorted keys): what a resumed sweep
+    compares to know a stored result was made with the same settings."""
+    text = json.dumps(request, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
 # --- many designs ------------------------------------------------------------------------
+
+#: Columns of summary.csv, one row per design.
+SUMMARY_COLUMNS = (
+    "name",
+    "status",
+    "max_rel_err_upper_half",
+    "target_error_bem",
+    "target_error_model",
+    "error",
+)
 
 
 def _design_list(designs: Sequence[str | os.PathLike[str] | Design] | str | os.PathLike[str]):
@@ -218,6 +282,8 @@ def _design_list(designs: Sequence[str | os.PathLike[str] | Design] | str | os.P
             out.append((f"design_{i:04d}", item))
         else:
             out.append((Path(item).stem, Design.load(item)))
+    if not out:
+        raise MetainterfaceError("designs: no designs given")
     names = [n for n, _ in out]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
@@ -225,14 +291,80 @@ def _design_list(designs: Sequence[str | os.PathLike[str] | Design] | str | os.P
     return out
 
 
-def _stored(folder: Path, request: dict[str, Any]) -> dict[str, Any] | None:
+def _stored(folder: Path, request: dict[str, Any], fields: bool, figure: bool) -> dict | None:
+    """The summary of a finished result made with the same settings (and the files asked
+    for), or None."""
     try:
         record = json.loads((folder / "result.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
-    if record.get("request") != request:
+    if record.get("request_hash") != request_hash(request) or record.get("request") != request:
+        return None
+    if fields and not (folder / FIELDS_FILE).exists():
+        return None
+    if figure and not (folder / "validation.png").exists():
         return None
     return record.get("summary")
+
+
+def _swap_in(staging: Path, final: Path) -> None:
+    """Put a finished folder in place of ``final`` (two renames, no half-written folder)."""
+    if final.exists():
+        old = final.with_name(f".{final.name}.old-{uuid.uuid4().hex[:8]}")
+        os.replace(final, old)
+        os.replace(staging, final)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(staging, final)
+
+
+def _staging(out: Path, name: str) -> Path:
+    return out / f".{name}.partial-{uuid.uuid4().hex[:8]}"
+
+
+def _clear_leftovers(out: Path) -> None:
+    """Remove what a sweep killed while writing leaves: hidden design folders, and the
+    temporary files of summary.csv / summary.json (``atomic_open``'s ``.NAME.*.tmp``)."""
+    if out.is_dir():
+        for leftover in [*out.glob(".*.partial-*"), *out.glob(".*.old-*")]:
+            shutil.rmtree(leftover, ignore_errors=True)
+        for name in ("summary.csv", "summary.json"):
+            for tmp in out.glob(f".{name}.*.tmp"):
+                tmp.unlink(missing_ok=True)
+
+
+def summary_row(name: str, summary: dict[str, Any]) -> dict[str, Any]:
+    """One row of summary.csv: name, status (ok / failed), the largest relative error over
+    the upper half of the loads, the target errors (BEM, model; blank without a target),
+    the error message of a failed design."""
+    if "error" in summary:
+        return {"name": name, "status": "failed", "error": summary["error"]}
+    return {
+        "name": name,
+        "status": "ok",
+        "max_rel_err_upper_half": summary.get("max_rel_err_upper_half"),
+        "target_error_bem": summary.get("target_error_bem"),
+        "target_error_model": summary.get("target_error_model"),
+    }
+
+
+def _cell(value: Any) -> Any:
+    if value is None:
+        return ""
+    return repr(float(value)) if isinstance(value, float) else value  # repr: exact floats
+
+
+def _write_summary(out: Path, rows: list[dict[str, Any]], **settings: Any) -> None:
+    buf = io.StringIO()
+    buf.write(csv_header(**settings))
+    writer = csv.DictWriter(buf, SUMMARY_COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        cells = {k: _cell(v) for k, v in row.items()}
+        # '#' starts a comment for pandas.read_csv(comment="#"): keep messages readable there
+        cells["error"] = str(cells.get("error", "")).replace("#", "no.").replace("\n", " ")
+        writer.writerow(cells)
+    write_text(out / "summary.csv", buf.getvalue())
 
 
 def validate_many(
@@ -241,24 +373,74 @@ def validate_many(
     *,
     grid: int | None = None,
     loads: int | Sequence[float] | np.ndarray = DEFAULT_LOADS,
-    jobs: int = 1,
+    jobs: int | None = 1,
     model: str | ForwardModel | None = None,
     tolerance: float = TOLERANCE,
     max_iter: int = MAX_ITER,
     figures: bool = False,
+    fields: bool = False,
+    chunks: int = 1,
+    executor: Executor | None = None,
+    scheduler: str | None = None,
+    retries: int = RETRIES,
     progress: bool = True,
 ) -> dict[str, dict[str, Any]]:
-    """Validate many designs (a folder of design files, a list of files or Designs).
+    """Validate many designs against BEM, on local processes or any executor.
 
-    Each design's results go to ``out_dir/<name>/`` (see ``write_result``) as soon as it is
-    done, one design per process with ``jobs > 1``. A design whose result.json records the
-    same request (design, grid, loads, model, solver settings) is skipped, so an
-    interrupted sweep resumes where it stopped. A design that fails (e.g. no convergence)
-    gets ``error.txt`` and the sweep goes on. ``out_dir/summary.json`` lists every design.
-    Returns {name: summary} (summary has an "error" key for failed designs).
+    Parameters
+    ----------
+    designs : folder, list of paths or Designs
+        A folder of design files (*.json), a list of files, or Design objects (named
+        design_0000, ...).
+    out_dir : path
+        Each design's results go to ``out_dir/<name>/`` (see ``write_result``), written
+        whole as soon as it is done; ``out_dir/summary.csv`` (columns ``SUMMARY_COLUMNS``)
+        and ``summary.json`` are rewritten after each design.
+    grid, loads, model, tolerance, max_iter :
+        As in ``validate``, for every design.
+    jobs : int
+        Local processes (default 1: in this process; None: the cores), or the workers of
+        ``scheduler="local"``.
+    figures, fields : bool
+        Also write validation.png / fields.nc for every design.
+    chunks : int
+        Split each design's load path into this many warm-started tasks (for fewer designs
+        than workers); default one task per design.
+    executor : concurrent.futures.Executor
+        Run the tasks there: ``dask.distributed.Client(...).get_executor()``,
+        ``mpi4py.futures.MPIPoolExecutor()``, a dask-jobqueue cluster's client, ...
+    scheduler : str
+        Or a Dask scheduler: ``"tcp://HOST:PORT"`` joins a running cluster, ``"local"``
+        starts a LocalCluster of ``jobs`` processes (the ``distributed`` extra).
+    retries : int
+        Times a task lost by the engine (a worker that died) is submitted again.
+    progress : bool
+        A progress bar over the designs.
+
+    Returns
+    -------
+    dict
+        {name: summary}; a failed design's summary has an "error" key (and its folder an
+        error.txt).
+
+    Notes
+    -----
+    A design whose result.json records the same request (design, grid, loads, model,
+    solver settings; compared by hash) and has the files asked for is skipped, so a sweep
+    that was interrupted, or that lost its engine, resumes where it stopped. A design that
+    fails (e.g. no convergence) gets error.txt and the sweep goes on; it is tried again on
+    the next run.
     """
     require_tamaas()
-    jobs = check_jobs(jobs)
+    jobs = available_cpus() if jobs is None else check_jobs(jobs)
+    chunks = _checks.whole("chunks", chunks, low=1, high=10_000)
+    retries = _checks.whole("retries", retries, low=0, high=100)
+    if fields:
+        require_xarray()
+    if executor is not None and scheduler is not None:
+        raise MetainterfaceError("give executor or scheduler, not both")
+    if scheduler is not None:
+        check_scheduler(scheduler)
     out = Path(out_dir)
     items = _design_list(designs)
     summaries: dict[str, dict[str, Any]] = {}
@@ -276,52 +458,88 @@ def validate_many(
             )
         except MetainterfaceError as exc:
             raise MetainterfaceError(f"{name}: {exc}") from None
-        done = _stored(out / name, prep.request())
+        done = _stored(out / name, prep.request(), fields, figures)
         if done is not None:
             summaries[name] = done
         else:
             todo.append(prep)
-
-    bar = None
-    if progress and todo:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=len(todo), desc="designs", unit="design")
+    _clear_leftovers(out)
+    sweep = {
+        "command": "validate_many",
+        "grid": grid,
+        "loads": loads if isinstance(loads, int) else [float(p) for p in loads],
+        "model": get_model(model).label,
+        "tolerance": tolerance,
+        "max_iter": max_iter,
+    }
 
     def write_summary() -> None:
         ordered = {n: summaries[n] for n, _ in items if n in summaries}
-        write_text(
-            out / "summary.json",
-            json.dumps(
-                {"designs": ordered, "provenance": provenance(command="validate_many")}, indent=2
-            )
-            + "\n",
-        )
+        _write_summary(out, [summary_row(n, s) for n, s in ordered.items()], **sweep)
+        record = {"designs": ordered, "provenance": provenance(**sweep)}
+        write_text(out / "summary.json", json.dumps(record, indent=2) + "\n")
 
-    def on_done(i: int, path: LoadPath) -> None:
-        prep = todo[i]
+    # one design's chunks: (design index in todo, its tasks); flat list for the engine
+    tasks, owner = [], []
+    for d, prep in enumerate(todo):
+        for task in prep.tasks(chunks, fields=fields):
+            tasks.append(task)
+            owner.append(d)
+    parts: dict[int, dict[int, LoadPath]] = {d: {} for d in range(len(todo))}
+    failed: set[int] = set()
+    n_chunks = collections.Counter(owner)
+
+    bar: Any = None
+
+    def on_done(i: int, part: LoadPath) -> None:
+        d = owner[i]
+        if d in failed:
+            return
+        parts[d][i] = part
+        if len(parts[d]) < n_chunks[d]:
+            return
+        prep = todo[d]
+        path = LoadPath.concat([parts[d][j] for j in sorted(parts[d])])
+        parts[d].clear()
         result = prep.result(path)
-        folder = out / prep.name
-        (folder / "error.txt").unlink(missing_ok=True)
-        write_result(result, folder, figure=figures, command="validate_many")
+        staging = _staging(out, prep.name)
+        write_result(result, staging, figure=figures, command="validate_many")
+        _swap_in(staging, out / prep.name)
         summaries[prep.name] = result.summary()
         write_summary()
         if bar is not None:
             bar.update(1)
 
     def on_error(i: int, exc: BaseException) -> None:
-        prep = todo[i]
-        write_text(out / prep.name / "error.txt", f"{exc}\n")
+        d = owner[i]
+        if d in failed:
+            return
+        failed.add(d)
+        parts[d].clear()
+        prep = todo[d]
+        staging = _staging(out, prep.name)
+        write_text(staging / "error.txt", f"{exc}\n")
+        _swap_in(staging, out / prep.name)
         summaries[prep.name] = {"name": prep.name, "error": str(exc)}
         write_summary()
         if bar is not None:
             bar.update(1)
 
-    try:
-        # tasks are built (height maps computed) only as processes take them
-        run_tasks([p.task for p in todo], jobs, on_done=on_done, on_error=on_error)
-    finally:
-        if bar is not None:
-            bar.close()
+    with contextlib.ExitStack() as stack:
+        if scheduler is not None and tasks:  # joined first: a bad address fails before the bar
+            executor = stack.enter_context(dask_executor(scheduler, jobs))
+        if progress and todo:
+            from tqdm.auto import tqdm
+
+            bar = stack.enter_context(tqdm(total=len(todo), desc="designs", unit="design"))
+        stream(
+            solve_task,
+            tasks,
+            executor=executor,
+            jobs=jobs,
+            on_done=on_done,
+            on_error=on_error,
+            retries=retries,
+        )
     write_summary()
     return {n: summaries[n] for n, _ in items}

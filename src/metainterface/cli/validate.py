@@ -1,8 +1,14 @@
-"""`metainterface validate`: a design against the boundary element method (Tamaas)."""
+"""`metainterface validate`: designs against the boundary element method (Tamaas).
+
+One design file: its results in DIR (``mi.validate``). Several files or a folder: a sweep,
+DIR/<name>/ per design and DIR/summary.csv (``mi.validate_many``), on local processes or a
+Dask cluster (``--scheduler``).
+"""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from metainterface.cli.common import positive_float, positive_int
 from metainterface.physics.models import DEFAULT_MODEL, MODELS
@@ -20,9 +26,18 @@ def register(sub: argparse._SubParsersAction) -> None:
         "in contact is kept as alpha_bem_pixels. Writes DIR/bem.csv "
         "(p_star,alpha_bem,alpha_model,rel_err,p_max,alpha_bem_pixels), "
         "DIR/asperities.csv, DIR/validation.png, DIR/result.json and DIR/models.csv (alpha "
-        "and rel_err of both forward models at the same loads).",
+        "and rel_err of both forward models at the same loads). With several design files "
+        "or a folder of them: a sweep that writes DIR/<name>/ per design as each finishes "
+        "and DIR/summary.csv (name, status, largest relative error over the upper half of "
+        "the loads, target errors), and resumes where it stopped when run again with the "
+        "same settings; exit status 1 if a design failed.",
     )
-    p.add_argument("design", help="design file (metainterface/design-v1 JSON)")
+    p.add_argument(
+        "designs",
+        nargs="+",
+        metavar="DESIGN",
+        help="design file(s) (metainterface/design-v1 JSON), or a folder of them",
+    )
     p.add_argument(
         "--grid",
         type=positive_int,
@@ -44,11 +59,37 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="largest load P* (default: P* at Delta_max; must not exceed it)",
     )
     p.add_argument(
+        "--workers",
         "--jobs",
+        dest="workers",
         type=positive_int,
-        metavar="J",
-        help="processes; the load path is split into J warm-started chunks "
-        "(default: the available cores)",
+        metavar="N",
+        help="worker processes, local or of --scheduler local (default: the available "
+        "cores); one design's load path is split into N warm-started chunks",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDR",
+        help="run on Dask (the [distributed] extra): tcp://HOST:PORT joins a running "
+        "cluster (`dask scheduler`, dask-jobqueue), 'local' starts a LocalCluster of N "
+        "workers",
+    )
+    p.add_argument(
+        "--chunks",
+        type=positive_int,
+        metavar="C",
+        help="sweeps: split each design's load path into C warm-started tasks (default 1)",
+    )
+    p.add_argument(
+        "--fields",
+        action="store_true",
+        help="also write DIR/fields.nc: pressure, gap and contact mask at every load "
+        "(NetCDF4, open with xarray.open_dataset; the [fields] extra)",
+    )
+    p.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="sweeps: skip validation.png for each design",
     )
     p.add_argument(
         "--tolerance",
@@ -71,16 +112,20 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import metainterface as mi
 
+    if len(args.designs) > 1 or Path(args.designs[0]).is_dir():
+        return run_many(args)
     result = mi.validate(
-        args.design,
+        args.designs[0],
         grid=args.grid,
         loads=args.loads,
         p_max=args.p_max,
         model=args.physics,
         tolerance=args.tolerance,
-        jobs=args.jobs,
+        jobs=args.workers,
         progress=True,
         out=args.out,
+        fields=args.fields,
+        scheduler=args.scheduler,
     )
     rel = {name: result.alpha_bem / a - 1.0 for name, a in result.alpha_by_model.items()}
     k = len(result.p_star)
@@ -106,3 +151,37 @@ def run(args: argparse.Namespace) -> int:
             f"{result.model.label} model {100 * errors[1]:.3g} %"
         )
     return 0
+
+
+def run_many(args: argparse.Namespace) -> int:
+    import metainterface as mi
+
+    if args.p_max is not None:
+        raise mi.MetainterfaceError("--p-max applies to one design; sweeps use --loads")
+    designs = args.designs[0] if len(args.designs) == 1 else args.designs
+    summaries = mi.validate_many(
+        designs,
+        args.out,
+        grid=args.grid,
+        loads=args.loads,
+        jobs=args.workers,
+        model=args.physics,
+        tolerance=args.tolerance,
+        figures=not args.no_figures,
+        fields=args.fields,
+        chunks=args.chunks or 1,
+        scheduler=args.scheduler,
+    )
+    failed = [name for name, s in summaries.items() if "error" in s]
+    worst = max(
+        (s["max_rel_err_upper_half"] for s in summaries.values() if "error" not in s),
+        default=float("nan"),
+    )
+    print(
+        f"{args.out}/summary.csv: {len(summaries) - len(failed)} designs validated, "
+        f"{len(failed)} failed; largest relative error over the upper half of the loads "
+        f"{100 * worst:.3g} %"
+    )
+    for name in failed:
+        print(f"  {name}: {summaries[name]['error']}")
+    return 1 if failed else 0

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -19,10 +19,13 @@ def plot_validation(
     target: tuple[np.ndarray, np.ndarray] | None = None,
     title: str | None = None,
     width: float = 13.0,
+    fields: Any = None,
 ) -> Figure:
     """Three panels: alpha(P*) (target, model, BEM), the cell's height map, p/E* at the
     largest load. target: optional (p_star, alpha) arrays of the design's target curve.
-    title: a name (a path is cut to its file name); width: inches."""
+    title: a name (a path is cut to its file name); width: inches.
+    fields: the result's fields file as an xarray Dataset (``metainterface.io.fields``):
+    the pressure panel then shows what the file holds, in its coordinates and units."""
     fig, (ax_c, ax_h, ax_p) = panel_grid(3, width, min_panel=3.6, aspect=0.82)
     p_top = float(result.p_star[-1])
     keep = result.curve.p_star <= p_top * (1 + 1e-12)
@@ -67,8 +70,18 @@ def plot_validation(
     fig.colorbar(im, ax=ax_h, label="z / R", shrink=0.85, extend="min")
     tidy_axis(ax_h, bins=4)
 
-    im = ax_p.imshow(result.pressure, origin="lower", extent=extent, cmap="magma")
-    ax_p.set(xlabel="x / R", ylabel="y / R", title=rf"$p/E^*$ at $P^* = {p_top:.3g}$")
+    pressure, labels = result.pressure, ("x / R", "y / R")
+    if fields is not None:
+        last = fields["pressure"].isel(load=-1)
+        pressure, p_top = np.asarray(last.values), float(last["p_star"])
+        units = fields["x"].attrs.get("units", "R")
+        scale = 1e3 if units == "m" else 1.0  # metres are drawn in mm
+        x, y = scale * np.asarray(fields["x"].values), scale * np.asarray(fields["y"].values)
+        step = x[1] - x[0]  # pixel edges: the cell is periodic, grid point i at i * step
+        extent = (float(x[0]), float(x[-1] + step), float(y[0]), float(y[-1] + step))
+        labels = ("x / R", "y / R") if units == "R" else ("x [mm]", "y [mm]")
+    im = ax_p.imshow(pressure, origin="lower", extent=extent, cmap="magma")
+    ax_p.set(xlabel=labels[0], ylabel=labels[1], title=rf"$p/E^*$ at $P^* = {p_top:.3g}$")
     fig.colorbar(im, ax=ax_p, label=r"$p/E^*$", shrink=0.85)
     tidy_axis(ax_p, bins=4)
     if title:

@@ -54,6 +54,8 @@ class LoadPath:
     largest local p / E*. asperity_alpha: (K, N) contact area of each asperity / A_nom (its
     lattice cell's share of ``alpha``). residual: (K,) the solver's final error.
     seconds: (K,) wall time of each solve. pressure: (M, M) p / E* at the last load.
+    pressures, gaps: (K, M, M) p / E* and the gap [length] at every load, kept only when
+    the path was solved with ``fields=True`` (else None).
     """
 
     alpha: np.ndarray
@@ -63,6 +65,8 @@ class LoadPath:
     residual: np.ndarray
     seconds: np.ndarray
     pressure: np.ndarray
+    pressures: np.ndarray | None = None
+    gaps: np.ndarray | None = None
 
     @staticmethod
     def concat(parts: list[LoadPath]) -> LoadPath:
@@ -75,7 +79,15 @@ class LoadPath:
             residual=np.concatenate([p.residual for p in parts]),
             seconds=np.concatenate([p.seconds for p in parts]),
             pressure=parts[-1].pressure,
+            pressures=_stack([p.pressures for p in parts]),
+            gaps=_stack([p.gaps for p in parts]),
         )
+
+
+def _stack(parts: list[np.ndarray | None]) -> np.ndarray | None:
+    if any(p is None for p in parts):
+        return None
+    return np.concatenate(parts)  # type: ignore[arg-type]
 
 
 @contextlib.contextmanager
@@ -144,6 +156,7 @@ def solve_path(
     first_index: int = 0,
     total: int | None = None,
     report: Callable[[int], Any] | None = None,
+    fields: bool = False,
 ) -> LoadPath:
     """Solve the contact of one cell at ascending mean pressures ``loads`` (K,) [P* = P/E*].
 
@@ -151,7 +164,9 @@ def solve_path(
     asperity index of each grid point. The first load starts from zero traction, each next
     one from the previous solution. ``report(1)`` is called after each load. ``first_index``
     and ``total`` only number the loads in error messages (for chunks of a longer path).
-    Raises MetainterfaceError naming the load and the residual if a solve does not converge.
+    fields: also keep the pressure and gap fields of every load (``LoadPath.pressures``,
+    ``gaps``; 2 K M^2 floats). Raises MetainterfaceError naming the load and the residual
+    if a solve does not converge.
     """
     tm = require_tamaas()
     loads = np.asarray(loads, dtype=np.float64)
@@ -162,6 +177,8 @@ def solve_path(
     alpha, alpha_pixels, p_max, residual, seconds = (np.empty(k) for _ in range(5))
     per = np.empty((k, n_asperities))
     owner_flat = np.asarray(owner).ravel()
+    pressures = np.empty((k, m, m)) if fields else None
+    gaps = np.empty((k, m, m)) if fields else None
     with _quiet(tm):
         model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [float(cell_side)] * 2, [m, m])
         model.E, model.nu = 1.0, 0.0  # E* = E / (1 - nu^2) = 1
@@ -189,10 +206,14 @@ def solve_path(
             alpha[i], per[i], alpha_pixels[i] = contact_area(traction, owner_flat, n_asperities)
             p_max[i] = float(traction.max())
             residual[i] = err
+            if pressures is not None and gaps is not None:
+                pressures[i] = traction
+                # Tamaas's displacement equals the surface where in contact: gap = u - z >= 0
+                gaps[i] = model.displacement.reshape(m, m) - surface
             if report is not None:
                 report(1)
         pressure = np.array(model.traction.reshape(m, m), copy=True)
-    return LoadPath(alpha, alpha_pixels, p_max, per, residual, seconds, pressure)
+    return LoadPath(alpha, alpha_pixels, p_max, per, residual, seconds, pressure, pressures, gaps)
 
 
 # --- processes ---------------------------------------------------------------------------
@@ -338,6 +359,7 @@ def solve_loads(
     max_iter: int = MAX_ITER,
     weights: np.ndarray | None = None,
     progress: Callable[[int], Any] | None = None,
+    fields: bool = False,
 ) -> LoadPath:
     """One cell's load path (K,), split into ``jobs`` contiguous warm-started chunks.
 
@@ -355,6 +377,7 @@ def solve_loads(
         tolerance=tolerance,
         max_iter=max_iter,
         total=len(loads),
+        fields=fields,
     )
     tasks = [{**common, "loads": loads[c], "first_index": int(c[0])} for c in chunks]
     parts = run_tasks(tasks, jobs, progress=progress)

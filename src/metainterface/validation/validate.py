@@ -15,6 +15,7 @@ from __future__ import annotations
 import functools
 import json
 from collections.abc import Callable, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,7 +24,15 @@ import numpy as np
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, ModelCurve, get_model, models_at
-from metainterface.validation.bem import MAX_ITER, TOLERANCE, LoadPath, require_tamaas, solve_loads
+from metainterface.validation.bem import (
+    MAX_ITER,
+    TOLERANCE,
+    LoadPath,
+    require_tamaas,
+    solve_loads,
+    split_path,
+)
+from metainterface.validation.engine import BemTask, solve_task, stream
 from metainterface.validation.heightmap import HeightMap, check_grid, default_grid, height_map
 
 #: Default number of loads of a path.
@@ -43,7 +52,9 @@ class ValidationResult:
     asperity / A_nom (model one None if the model does not resolve asperities). residual,
     seconds: (K,) solver error and wall time per load. pressure: (M, M) p / E* at the
     largest load. heights: the cell's HeightMap. model: the forward model compared with;
-    curve: its dense curve.
+    curve: its dense curve. pressures, gaps: (K, M, M) p / E* and the gap [length] at every
+    load, or None (kept when solved with ``fields=True``; written by ``write_result`` as
+    fields.nc).
     """
 
     name: str
@@ -64,6 +75,8 @@ class ValidationResult:
     pressure: np.ndarray
     heights: HeightMap
     curve: ModelCurve
+    pressures: np.ndarray | None = None
+    gaps: np.ndarray | None = None
 
     @property
     def rel_err(self) -> np.ndarray:
@@ -250,16 +263,70 @@ class ValidationPlan:
             self.design, self.grid, self.loads, self.model, self.tolerance, self.max_iter
         )
 
-    def solve(
-        self, jobs: int = 1, progress: Callable[[int], Any] | None = None
-    ) -> ValidationResult:
-        """Run the BEM load path on ``jobs`` processes; progress(n) as loads finish."""
-        jobs = check_jobs(jobs)
-        heights, curve = self.height_map(), self.model_curve()
+    def load_weights(self, curve: ModelCurve | None = None) -> np.ndarray:
+        """(K,) expected relative cost of each load, to balance a path's chunks."""
+        curve = self.model_curve() if curve is None else curve
         # PKR needs more iterations as contacts grow, roughly alpha^(1/8) (measured on 384^2
         # paths: 61 -> 82 iterations). Balanced chunks keep every process busy to the end.
-        weights = np.maximum(curve.at(self.loads)[0], 1e-12) ** 0.125
-        path = solve_loads(**self.task(heights), jobs=jobs, weights=weights, progress=progress)
+        return np.maximum(curve.at(self.loads)[0], 1e-12) ** 0.125
+
+    def tasks(
+        self, chunks: int = 1, *, fields: bool = False, curve: ModelCurve | None = None
+    ) -> list[BemTask]:
+        """The path as ``chunks`` contiguous warm-started tasks of about equal cost."""
+        weights = self.load_weights(curve) if chunks > 1 else None
+        parts = split_path(len(self.loads), chunks, weights)
+        return [
+            BemTask(
+                design=self.design,
+                grid=self.grid,
+                loads=self.loads[c],
+                first_index=int(c[0]),
+                total=len(self.loads),
+                tolerance=self.tolerance,
+                max_iter=self.max_iter,
+                fields=fields,
+            )
+            for c in parts
+        ]
+
+    def solve(
+        self,
+        jobs: int = 1,
+        progress: Callable[[int], Any] | None = None,
+        *,
+        executor: Executor | None = None,
+        fields: bool = False,
+    ) -> ValidationResult:
+        """Run the BEM load path as ``jobs`` warm-started chunks; progress(n) as loads finish.
+
+        executor: run the chunks there (any ``concurrent.futures.Executor``); default local
+        processes. fields: keep every load's pressure and gap fields.
+        """
+        jobs = check_jobs(jobs)
+        heights, curve = self.height_map(), self.model_curve()
+        if executor is None:
+            path = solve_loads(
+                **self.task(heights),
+                jobs=jobs,
+                weights=self.load_weights(curve),
+                progress=progress,
+                fields=fields,
+            )
+            return self.result(path, heights=heights, curve=curve)
+        tasks = self.tasks(jobs, fields=fields, curve=curve)
+        parts: list[LoadPath | None] = [None] * len(tasks)
+
+        def done(i: int, part: LoadPath) -> None:
+            parts[i] = part
+            if progress is not None:
+                progress(len(tasks[i].loads))
+
+        def fail(i: int, exc: BaseException) -> None:
+            raise exc
+
+        stream(solve_task, tasks, executor=executor, on_done=done, on_error=fail)
+        path = LoadPath.concat([p for p in parts if p is not None])
         return self.result(path, heights=heights, curve=curve)
 
     def result(
@@ -291,6 +358,8 @@ class ValidationPlan:
             pressure=path.pressure,
             heights=self.height_map() if heights is None else heights,
             curve=curve,
+            pressures=path.pressures,
+            gaps=path.gaps,
         )
 
 
