@@ -120,6 +120,25 @@ def test_sweep_on_the_command_line_writes_a_summary_table(tmp_path, capsys):
     assert (out / "bad" / "error.txt").exists() and not (out / "bad" / "result.json").exists()
 
 
+def test_a_folder_of_design_runs_is_swept_by_their_folder_names(tmp_path, capsys):
+    """`design` writes RUN/<target>/design.json: a sweep over such files (or over RUN)
+    names each result after its folder, and only colliding names take more of the path."""
+    runs = tmp_path / "runs"
+    one_asperity(2.0).save(runs / "soft" / "design.json")
+    one_asperity(3.0).save(runs / "blunt" / "design.json")
+    one_asperity(4.0).save(tmp_path / "other" / "soft" / "design.json")
+    args = ["--grid", "16", "--loads", "2", "--workers", "1"]
+    assert main(["validate", str(runs), *args, "--out", str(tmp_path / "a")]) == 0
+    assert sorted(table(tmp_path / "a")["name"]) == ["blunt", "soft"]
+    listed = [str(p) for p in sorted(tmp_path.glob("*/*/design.json"))]
+    assert main(["validate", *listed, *args, "--out", str(tmp_path / "b")]) == 0
+    assert sorted(table(tmp_path / "b")["name"]) == ["blunt", "other-soft", "runs-soft"]
+    capsys.readouterr()
+    same = [listed[0], listed[0]]
+    assert main(["validate", *same, *args, "--out", str(tmp_path / "c")]) == 2
+    assert "must be unique" in capsys.readouterr().err
+
+
 def _run_cli(args: list[str], **kw) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": SRC, "OMP_NUM_THREADS": "1"}
     return subprocess.Popen(

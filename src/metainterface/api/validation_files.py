@@ -272,16 +272,19 @@ def _design_list(designs: Sequence[str | os.PathLike[str] | Design] | str | os.P
         folder = Path(designs)
         if not folder.is_dir():
             raise MetainterfaceError(f"{folder}: not a folder of design files")
-        files = sorted(folder.glob("*.json"))
+        # design files in it, or the result folders `design` writes (one design.json each)
+        files = sorted(folder.glob("*.json")) or sorted(folder.glob("*/design.json"))
         if not files:
-            raise MetainterfaceError(f"{folder}: no design files (*.json) in it")
+            raise MetainterfaceError(f"{folder}: no design files (*.json or */design.json) in it")
         designs = files
+    items = list(designs)
+    labels = _file_labels([Path(d) for d in items if not isinstance(d, Design)])
     out: list[tuple[str, Design]] = []
-    for i, item in enumerate(designs):
+    for i, item in enumerate(items):
         if isinstance(item, Design):
             out.append((f"design_{i:04d}", item))
         else:
-            out.append((Path(item).stem, Design.load(item)))
+            out.append((labels[Path(item)], Design.load(item)))
     if not out:
         raise MetainterfaceError("designs: no designs given")
     names = [n for n, _ in out]
@@ -289,6 +292,27 @@ def _design_list(designs: Sequence[str | os.PathLike[str] | Design] | str | os.P
     if dup:
         raise MetainterfaceError(f"design names must be unique, repeated: {', '.join(dup)}")
     return out
+
+
+def _file_labels(paths: list[Path]) -> dict[Path, str]:
+    """A result name per design file: its stem, or its folder for the ``design.json`` that
+    ``design`` writes; where names collide, as many parent folders as make them distinct."""
+
+    def label(p: Path, depth: int) -> str:
+        parents = p.resolve().parent.parts[1:]
+        depth = max(depth, 1) if p.stem == "design" else depth
+        parts = list(parents[len(parents) - depth :]) if depth else []
+        return "-".join(parts if p.stem == "design" and parts else [*parts, p.stem])
+
+    depth = dict.fromkeys(paths, 0)
+    for _ in range(max((len(p.resolve().parts) for p in depth), default=0)):
+        names = {p: label(p, d) for p, d in depth.items()}
+        clash = [p for p, n in names.items() if list(names.values()).count(n) > 1]
+        if not clash:
+            break
+        for p in clash:  # only the colliding names grow
+            depth[p] += 1
+    return {p: label(p, d) for p, d in depth.items()}
 
 
 def _stored(folder: Path, request: dict[str, Any], fields: bool, figure: bool) -> dict | None:
