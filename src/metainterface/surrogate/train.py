@@ -49,7 +49,7 @@ class TrainConfig:
     physics_steps: Delta samples of the physics layer during training (the loss is still on
     the curves' n_steps pressure grid); fewer samples make an epoch cheaper.
     max_gap: the network's height-gap scale in units of Delta_max (None: the paper's
-    2 / (N - 1); see :mod:`metainterface.surrogate.model`).
+    2 / (N - 1); see ``metainterface.surrogate.model``).
     w_shape, w_grad, w_mag: the weights of the composite loss, also used for the validation
     loss that early stopping watches. The paper's are 10, 1, 10; with them the magnitude term
     is a small part of the loss and the errors of P*_max and alpha_max dominate the zero-shot

@@ -89,12 +89,12 @@ class ValidationResult:
 
     @property
     def max_rel_err_upper(self) -> float:
-        """Largest |rel_err| over the upper half of the loads."""
+        """Largest abs(rel_err) over the upper half of the loads."""
         return float(np.abs(self.rel_err[self.upper_half]).max())
 
     @property
     def max_rel_err(self) -> float:
-        """Largest |rel_err| over all loads."""
+        """Largest abs(rel_err) over all loads."""
         return float(np.abs(self.rel_err).max())
 
     @property
