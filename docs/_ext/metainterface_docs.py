@@ -264,7 +264,8 @@ def write_reference(srcdir: Path) -> list[str]:
 
 
 def _on_builder_inited(app: Sphinx) -> None:
-    write_reference(Path(app.srcdir))
+    if (Path(app.srcdir) / "reference" / "index.rst").exists():  # the docs, not a test page
+        write_reference(Path(app.srcdir))
 
 
 def _prose_first_line(
