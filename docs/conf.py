@@ -31,7 +31,6 @@ version = release
 extensions = [
     "myst_nb",
     "sphinx.ext.autodoc",
-    "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
     "metainterface_docs",
@@ -53,7 +52,6 @@ autodoc_typehints = "signature"
 autodoc_typehints_format = "short"
 autodoc_member_order = "bysource"
 autodoc_class_signature = "separated"
-autosummary_generate = False
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 # Types in "Parameters" and "Returns" are prose ("Design or path", "(N,) array"): shown as
@@ -89,5 +87,6 @@ html_theme_options = {
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["custom.css"]
 html_show_sourcelink = False

@@ -32,7 +32,9 @@ def _sphinx(src: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
 
 def _doc_comment(obj: object, name: str) -> str | None:
     """The ``#:`` comment of a module-level binding of ``obj`` to ``name`` in the package."""
-    modules = [m for m in sorted(sys.modules) if m == "metainterface" or m.startswith("metainterface.")]
+    modules = [
+        m for m in sorted(sys.modules) if m == "metainterface" or m.startswith("metainterface.")
+    ]
     for modname in modules:
         if getattr(sys.modules[modname], name, None) is not obj:
             continue

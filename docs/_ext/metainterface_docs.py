@@ -19,10 +19,11 @@ from __future__ import annotations
 import builtins
 import importlib
 import inspect
+import itertools
 import re
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from docutils import nodes
 from docutils.parsers.rst import directives
@@ -53,7 +54,7 @@ def sections(module: Any) -> dict[str, list[str]]:
     public = public_names(module)
     out: dict[str, list[str]] = {}
     lines = (module.__doc__ or "").splitlines()
-    for title, body in zip(lines, lines[1:], strict=False):
+    for title, body in itertools.pairwise(lines):
         if not title.strip() or title.startswith(" ") or not body.startswith("    "):
             continue
         names = [n.strip() for n in re.sub(r"\(.*?\)", "", body).split(",")]
@@ -204,16 +205,26 @@ def _object_page(name: str, obj: Any, full: str, module: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _summary(names: list[str], module: str) -> list[str]:
-    return [
-        f".. currentmodule:: {module}",
-        "",
-        ".. autosummary::",
-        "   :nosignatures:",
-        "",
-        *(f"   {n}" for n in names),
-        "",
-    ]
+def first_sentence(text: str) -> str:
+    """The first sentence of a docstring's first paragraph: up to a full stop followed by a
+    capital letter or the end ("paper sec. 2.3" and "fig. 5" do not end it)."""
+    para = " ".join(text.strip().split("\n\n")[0].split())
+    match = re.search(r"\.(?=\s+[A-Z`(]|$)", para)
+    return para[: match.end()] if match else para
+
+
+def _summary(names: list[str], module: str, docs: dict[str, str]) -> list[str]:
+    """A two-column table: each name linked to its page, and its docstring's first sentence."""
+    lines = [f".. currentmodule:: {module}", "", ".. list-table::", "   :widths: 25 75", ""]
+    for n in names:
+        lines += [f"   * - :py:obj:`{n}`", f"     - {first_sentence(docs.get(n, '')) or ' '}"]
+    return [*lines, ""]
+
+
+def _doc_of(obj: Any, name: str) -> str:
+    if inspect.isclass(obj) or callable(obj):
+        return own_docstring(obj) or ""
+    return attribute_comment(obj, name) or ""
 
 
 def write_reference(srcdir: Path) -> list[str]:
@@ -226,7 +237,7 @@ def write_reference(srcdir: Path) -> list[str]:
     body = []
     for title, names in sections(module).items():
         body += _title(title, "-")
-        body += _summary(names, PACKAGE)
+        body += _summary(names, PACKAGE, {n: _doc_of(getattr(module, n), n) for n in names})
         for n in names:
             pages[f"{PACKAGE}.{n}"] = _object_page(n, getattr(module, n), f"{PACKAGE}.{n}", PACKAGE)
     extra = supporting_types(module)
@@ -237,13 +248,14 @@ def write_reference(srcdir: Path) -> list[str]:
             "functions above. Each is documented under the module that defines it.",
             "",
         ]
-        by_module: dict[str, list[str]] = {}
+        by_module: dict[str, dict[str, str]] = {}
         for cls in extra:
-            by_module.setdefault(cls.__module__, []).append(cls.__qualname__)
+            by_module.setdefault(cls.__module__, {})[cls.__qualname__] = _doc_of(cls, "")
             full = f"{cls.__module__}.{cls.__qualname__}"
-            pages[full] = _object_page(cls.__qualname__, cls, full, cls.__module__)
-        for mod, names in by_module.items():
-            body += _summary(names, mod)
+            # titled by the full path: two modules may each have a class of one name
+            pages[full] = _object_page(full, cls, full, cls.__module__)
+        for mod, docs in by_module.items():
+            body += _summary(list(docs), mod, docs)
     body += [".. toctree::", "   :hidden:", "", *(f"   generated/{p}" for p in pages), ""]
     files = {f"{p}.rst": text for p, text in pages.items()}
     files["_body.inc"] = "\n".join(body) + "\n"
@@ -303,18 +315,6 @@ def _parsable_signature(
     return None
 
 
-def _data_comment(
-    app: Sphinx, what: str, name: str, obj: Any, options: Any, lines: list[str]
-) -> None:
-    """A public data name's doc is its ``#:`` comment, not its type's docstring (autosummary
-    would otherwise summarise ``MODELS`` by ``dict.__doc__``)."""
-    if what != "data" or not name.startswith(PACKAGE + "."):
-        return
-    comment = attribute_comment(obj, name.rpartition(".")[2])
-    if comment is not None:
-        lines[:] = comment.splitlines()
-
-
 def _on_missing_reference(app: Sphinx, env: Any, node: Any, contnode: Any) -> Any:
     """Resolve ``metainterface.sub.module.Name`` to ``metainterface.Name`` when public."""
     if node.get("refdomain") != "py":
@@ -354,7 +354,7 @@ class ReproducedFigures(SphinxDirective):
     """
 
     required_arguments = 1
-    option_spec = {"width": directives.unchanged}
+    option_spec: ClassVar[dict[str, Any]] = {"width": directives.unchanged}
 
     def run(self) -> list[nodes.Node]:
         rel = self.arguments[0]
@@ -384,7 +384,6 @@ class ReproducedFigures(SphinxDirective):
 def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("builder-inited", _on_builder_inited)
     app.connect("autodoc-process-docstring", _prose_first_line, priority=600)
-    app.connect("autodoc-process-docstring", _data_comment, priority=100)
     app.connect("autodoc-process-signature", _parsable_signature)
     app.connect("missing-reference", _on_missing_reference)
     app.add_directive("reproduced-figures", ReproducedFigures)
