@@ -184,12 +184,9 @@ def _object_page(name: str, obj: Any, full: str, module: str) -> str:
     """The rst page of one object, documented as ``full`` (module.name)."""
     lines = [*_title(name), f".. currentmodule:: {module}", ""]
     if inspect.isclass(obj):
-        lines += [
-            f".. autoclass:: {full}",
-            "   :members:",
-            "   :show-inheritance:",
-            "   :special-members: __call__",
-        ]
+        lines += [f".. autoclass:: {full}", "   :members:", "   :special-members: __call__"]
+        if obj.__bases__ != (object,):
+            lines += ["   :show-inheritance:"]
     elif callable(obj):
         lines += [f".. autofunction:: {full}"]
     else:
@@ -278,6 +275,38 @@ def write_reference(srcdir: Path) -> list[str]:
 def _on_builder_inited(app: Sphinx) -> None:
     if (Path(app.srcdir) / "reference" / "index.rst").exists():  # the docs, not a test page
         write_reference(Path(app.srcdir))
+
+
+def _prose_types(
+    app: Sphinx, what: str, name: str, obj: Any, options: Any, lines: list[str]
+) -> None:
+    """Show napoleon's ``:vartype x: ndarray, shape (K,)`` as prose in front of the ``:ivar:``
+    description: Sphinx would make a cross-reference of every word of it. Runs after
+    napoleon."""
+    # ":ivar a, b: ..." would read as a variable b of type "a,": one word, a zero-width space
+    # after each comma
+    lines[:] = [
+        re.sub(
+            r"^:ivar ([^:]+):", lambda m: ":ivar " + m.group(1).replace(", ", ",\u200b") + ":", line
+        )
+        if line.startswith(":ivar ")
+        else line
+        for line in lines
+    ]
+    types = {}
+    for line in lines:
+        match = re.match(r":vartype (.+?): (.*)$", line)
+        if match:
+            types[match.group(1).replace(", ", ",\u200b")] = match.group(2)
+    out = []
+    for line in lines:
+        if line.startswith(":vartype "):
+            continue
+        match = re.match(r"(:ivar (.+?):)( ?)(.*)$", line)
+        if match and match.group(2) in types:
+            line = f"{match.group(1)} *({types[match.group(2)]})* {match.group(4)}".rstrip()
+        out.append(line)
+    lines[:] = out
 
 
 def _prose_first_line(
@@ -384,6 +413,7 @@ class ReproducedFigures(SphinxDirective):
 def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("builder-inited", _on_builder_inited)
     app.connect("autodoc-process-docstring", _prose_first_line, priority=600)
+    app.connect("autodoc-process-docstring", _prose_types, priority=600)
     app.connect("autodoc-process-signature", _parsable_signature)
     app.connect("missing-reference", _on_missing_reference)
     app.add_directive("reproduced-figures", ReproducedFigures)
