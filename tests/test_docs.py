@@ -7,6 +7,7 @@ dead cross-reference fails the test command, not a later docs deployment.
 
 from __future__ import annotations
 
+import importlib.util
 import inspect
 import re
 import subprocess
@@ -102,3 +103,34 @@ def test_a_broken_example_fails_the_build(tmp_path):
     done = _sphinx(_project(tmp_path, page), tmp_path)
     assert done.returncode != 0
     assert "ExecutionError" in done.stderr and "index.md" in done.stderr
+
+
+def _extension():
+    """The docs' Sphinx extension (docs/_ext/metainterface_docs.py), imported from its file."""
+    spec = importlib.util.spec_from_file_location(
+        "metainterface_docs", DOCS / "_ext" / "metainterface_docs.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_name_added_to_all_gets_its_reference_page_and_a_missing_docstring_is_reported(
+    tmp_path, monkeypatch
+):
+    def documented(x: mi.Design) -> mi.Curve:
+        """A new public function, documented."""
+
+    def bare(x: float) -> float:
+        return x
+
+    monkeypatch.setattr(mi, "documented", documented, raising=False)
+    monkeypatch.setattr(mi, "bare", bare, raising=False)
+    monkeypatch.setattr(mi, "__all__", [*mi.__all__, "documented", "bare"])
+    missing = _extension().write_reference(tmp_path)
+    pages = tmp_path / "reference" / "generated"
+    assert "autofunction:: metainterface.documented" in (
+        pages / "metainterface.documented.rst"
+    ).read_text(encoding="utf-8")
+    assert "metainterface.documented" in (pages / "_body.inc").read_text(encoding="utf-8")
+    assert missing == ["bare"]
