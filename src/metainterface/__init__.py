@@ -81,6 +81,7 @@ from metainterface.surrogate.train import TrainConfig
 from metainterface.validation.validate import ValidationResult
 
 try:
+    #: The installed package's version (PEP 440); "0+unknown" in an uninstalled source tree.
     __version__ = version("metainterface")
 except PackageNotFoundError:  # running from a source tree that was not installed
     __version__ = "0+unknown"

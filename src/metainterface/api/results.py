@@ -44,9 +44,18 @@ def _axes(ax: Axes | None) -> Axes:
 class Curve:
     """The response of one design along its indentation sweep, as numpy arrays.
 
-    delta: (K,) global indentation Delta [units of R], from 0 to Delta_max.
-    p_star: (K,) dimensionless pressure P* = P / E*. alpha: (K,) contact-area fraction
-    A_real / A_nom. stiffness: (K,) S* = dP*/dalpha. model: the forward model's label.
+    Attributes
+    ----------
+    delta : ndarray, shape (K,)
+        Global indentation Delta [units of R], from 0 to Delta_max.
+    p_star : ndarray, shape (K,)
+        Dimensionless pressure P* = P / E*.
+    alpha : ndarray, shape (K,)
+        Contact-area fraction A_real / A_nom.
+    stiffness : ndarray, shape (K,)
+        S* = dP*/dalpha.
+    model : str
+        The forward model's label.
     """
 
     delta: np.ndarray
@@ -145,18 +154,40 @@ def decimate(n: int, most: int = RECORD_POINTS) -> np.ndarray:
 class DesignResult:
     """A designed unit cell for one target.
 
-    design: the cell (numpy gamma, h (N,), settings). error: relative curve error
-    ||alpha - alpha_target||_2 / ||alpha_target||_2 at the target's pressures (0.01 = 1 %).
-    initial_error: the same before refinement (the zero-shot prediction's, or the best
-    start's). method: surrogate, multistart or hertz. seconds: wall time per target.
-    model: the forward model designed with. start: which start won (0 = the zero-shot
-    prediction). fallback: the design came from the fallback multistart. notes: what the
-    pipeline decided on the user's behalf. pressure: the peak-pressure check, when a limit
-    was given. robust (robust design): the errors designed for and the statistics of the
-    made cells: error_nominal, error_median, error_p95 (over independent draws) and
-    error_rms_refined (over the copies refined against); robust_error_refined the latter.
-    printable (a layer height): z_step [R] and the error before the snap, after it and
-    after the re-refine (``error`` is the last).
+    Attributes
+    ----------
+    target : Target
+        The target designed for.
+    design : Design
+        The cell: numpy ``gamma`` and ``h`` (N,), and its settings.
+    error : float
+        Relative curve error ||alpha - alpha_target||_2 / ||alpha_target||_2 at the target's
+        pressures (0.01 = 1 %).
+    initial_error : float
+        The same before refinement (the zero-shot prediction's, or the best start's).
+    method : str
+        ``"surrogate"``, ``"multistart"`` or ``"hertz"``.
+    seconds : float
+        Wall time per target [s].
+    model : ForwardModel
+        The forward model designed with.
+    start : int
+        Which start won (0 = the zero-shot prediction); see :attr:`origin`.
+    fallback : bool
+        The design came from the fallback multistart.
+    notes : tuple of str
+        What the pipeline decided on the user's behalf.
+    pressure : PressureCheck or None
+        The peak-pressure check, when a limit was given.
+    robust : dict or None
+        Robust design only: the errors designed for and the statistics of the made cells:
+        ``error_nominal``, ``error_median``, ``error_p95`` (over independent draws) and
+        ``error_rms_refined`` (over the copies refined against).
+    robust_error_refined : float or None
+        Robust design only: the rms error over the copies refined against.
+    printable : dict or None
+        With a layer height: ``z_step`` [R] and the error before the snap, after it and
+        after the re-refine (``error`` is the last).
     """
 
     target: Target

@@ -414,8 +414,10 @@ def validate_many(
     Parameters
     ----------
     designs : folder, list of paths or Designs
-        A folder of design files (*.json), a list of files, or Design objects (named
-        design_0000, ...).
+        A folder of design files (``*.json``, or the ``*/design.json`` that ``design``
+        writes), a list of files, or Design objects (named ``design_0000``, ...). A file is
+        named by its stem, a ``design.json`` by its folder; colliding names take more of
+        their path.
     out_dir : path
         Each design's results go to ``out_dir/<name>/`` (see ``write_result``), written
         whole as soon as it is done; ``out_dir/summary.csv`` (columns ``SUMMARY_COLUMNS``)

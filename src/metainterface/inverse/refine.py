@@ -35,6 +35,17 @@ POLISH_METHODS = ("levmar", "lbfgs")
 
 @dataclass(frozen=True)
 class RefineSettings:
+    """The refinement's stages, iterations and tolerances (paper appendix C; the comments in
+    the source give the why of each).
+
+    ``stages`` softplus stages with kappa_s log-spaced from ``kappa_start`` to ``kappa_end``
+    [1/R], each ``steps_per_stage`` L-BFGS steps of at most ``iterations`` iterations at
+    learning rate ``lr``; the loss on ``grid_points`` uniform pressures, with weight
+    ``undershoot_weight`` where a design's curve stops short of the target. Then the best rows
+    get up to ``polish_iterations`` more by ``polish_method`` ("levmar" or "lbfgs") on the
+    exact contact law. Fewer stages or iterations make a quicker, rougher design.
+    """
+
     stages: int = 5
     steps_per_stage: int = 5
     iterations: int = 20

@@ -36,15 +36,25 @@ from metainterface.physics.curves import at_pressures, sweep
 class Target:
     """A target contact law alpha(P*): what a design should reproduce.
 
-    p_star: (M,) dimensionless pressures P* = P / E*, strictly increasing from 0 (or near it).
-    alpha: (M,) contact-area fractions A_real / A_nom in [0, 1), ending > 0.
-    name: a label (used for output folders). stiffness: optional (M,) S* = dP*/dalpha at the
-    same points (exact for built-ins). source: where it came from. meta: anything else
-    recorded with the designs (e.g. the friction law it was made from).
-
     Build one from arrays or lists (``Target(p_star=[...], alpha=[...], name="mine")``), or
     with :meth:`builtin`, :meth:`from_csv` or :meth:`from_friction`. Checked on
     construction: bad input raises MetainterfaceError naming the row and the rule.
+
+    Attributes
+    ----------
+    p_star : ndarray, shape (M,)
+        Dimensionless pressures P* = P / E*, strictly increasing from 0 (or near it).
+    alpha : ndarray, shape (M,)
+        Contact-area fractions A_real / A_nom in [0, 1), ending > 0.
+    name : str
+        A label (used for output folders).
+    stiffness : ndarray, shape (M,), or None
+        S* = dP*/dalpha at the same points, optional (exact for built-ins); without it the
+        surrogate estimates S* by finite differences.
+    source : str
+        Where it came from.
+    meta : dict
+        Anything else recorded with the designs (e.g. the friction law it was made from).
     """
 
     p_star: np.ndarray

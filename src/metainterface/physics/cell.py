@@ -45,12 +45,20 @@ def _finite(name: str, value: float, *, low: float | None = None, strict: bool =
 class CellSettings:
     """Everything that fixes the cell and its curves. Validated on construction.
 
-    n_asperities: N, a perfect square (1, 4, 9, 16, ...).
-    radius: R, the base radius shared by all shapes [length; 1 in the dimensionless core].
-    e_star: E*, the equivalent modulus [pressure; 1 in the dimensionless core].
-    delta_max: largest global indentation Delta_max [length]; the paper uses R / 50.
-    gamma_min, gamma_max: admissible shape exponents, 1 < gamma_min < gamma_max.
-    n_steps: points of the uniform pressure grid (and of the Delta sweep) of a curve.
+    Attributes
+    ----------
+    n_asperities : int
+        N, a perfect square (1, 4, 9, 16, ...).
+    radius : float
+        R, the base radius shared by all shapes [length; 1 in the dimensionless core].
+    e_star : float
+        E*, the equivalent modulus [pressure; 1 in the dimensionless core].
+    delta_max : float
+        Largest global indentation Delta_max [length]; the paper uses R / 50.
+    gamma_min, gamma_max : float
+        Admissible shape exponents, 1 < gamma_min < gamma_max.
+    n_steps : int
+        Points of the uniform pressure grid (and of the Delta sweep) of a curve.
     """
 
     n_asperities: int = 9
@@ -132,9 +140,16 @@ class CellSettings:
 class Design:
     """One unit-cell design: shape exponents and height offsets of its N asperities.
 
-    gamma: (N,) shape exponents in [gamma_min, gamma_max] (dimensionless).
-    h: (N,) height offsets >= 0 [length, units of R], asperity k in lattice cell (k // n, k % n).
-    settings: the cell they live in. extras: any other keys of a design file, kept as they are.
+    Attributes
+    ----------
+    gamma : ndarray, shape (N,)
+        Shape exponents in [gamma_min, gamma_max] (dimensionless).
+    h : ndarray, shape (N,)
+        Height offsets >= 0 [length, units of R], asperity k in lattice cell (k // n, k % n).
+    settings : CellSettings
+        The cell they live in.
+    extras : dict
+        Any other keys of a design file, kept as they are.
     """
 
     gamma: np.ndarray

@@ -21,6 +21,10 @@ from metainterface.physics.curves import Curve, relative_l2
 
 @dataclass(frozen=True)
 class LossWeights:
+    """Weights of the composite training loss (paper appendix A.2): ``shape`` the L1 of
+    alpha_hat and S_hat, ``grad`` the L1 of the S_hat differences, ``mag`` the squared log10
+    errors of P*_max and alpha_max, ``curve`` the relative curve error. Dimensionless."""
+
     shape: float = 10.0
     grad: float = 1.0
     mag: float = 10.0

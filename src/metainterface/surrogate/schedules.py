@@ -14,6 +14,11 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class Schedules:
+    """The training schedules by epoch: the softplus steepness kappa_s [1/R], raised
+    exponentially from ``kappa_start`` to ``kappa_end`` over the first ``kappa_fraction`` of
+    the ``epochs``, and the curriculum weight lambda, falling linearly from ``lambda_start``
+    to 0 over ``curriculum_epochs``."""
+
     epochs: int
     kappa_start: float = 1e3
     kappa_end: float = 1e5

@@ -46,17 +46,32 @@ METRICS = ("epoch", "train_loss", "val_loss", "kappa", "lambda", "lr", "seconds"
 class TrainConfig:
     """Hyper-parameters of a training run (all recorded in config.json and the model file).
 
-    physics_steps: Delta samples of the physics layer during training (the loss is still on
-    the curves' n_steps pressure grid); fewer samples make an epoch cheaper.
-    max_gap: the network's height-gap scale in units of Delta_max (None: the paper's
-    2 / (N - 1); see :mod:`metainterface.surrogate.model`).
-    w_shape, w_grad, w_mag: the weights of the composite loss, also used for the validation
-    loss that early stopping watches. The paper's are 10, 1, 10; with them the magnitude term
-    is a small part of the loss and the errors of P*_max and alpha_max dominate the zero-shot
-    error, which w_mag = 1000 removes (MODEL_CARD.md has the comparison).
-    w_curve: the weight of the relative curve error, the figure `evaluate` reports (not in
-    the paper: 0 there). It trains shape and magnitude together where they matter for
-    alpha(P*) (MODEL_CARD.md has the ablation).
+    Attributes
+    ----------
+    epochs, batch_size, lr, weight_decay, patience, seed
+        AdamW with a cosine learning rate peaking at ``lr``; early stopping after
+        ``patience`` epochs without a better validation loss; ``seed`` fixes every draw.
+    curriculum_epochs, lambda_start
+        The supervised anchor lambda falls linearly from ``lambda_start`` to 0 over
+        ``curriculum_epochs``.
+    kappa_start, kappa_end, kappa_fraction
+        The softplus steepness kappa_s [1/R] rises exponentially from ``kappa_start`` to
+        ``kappa_end`` over the first ``kappa_fraction`` of the epochs.
+    physics_steps : int
+        Delta samples of the physics layer during training (the loss is still on the
+        curves' n_steps pressure grid); fewer samples make an epoch cheaper.
+    max_gap : float or None
+        The network's height-gap scale in units of Delta_max (None: the paper's
+        2 / (N - 1); see ``metainterface.surrogate.model``).
+    w_shape, w_grad, w_mag : float
+        The weights of the composite loss, also used for the validation loss that early
+        stopping watches. The paper's are 10, 1, 10; with them the magnitude term is a small
+        part of the loss and the errors of P*_max and alpha_max dominate the zero-shot
+        error, which w_mag = 1000 removes (MODEL_CARD.md has the comparison).
+    w_curve : float
+        The weight of the relative curve error, the figure ``evaluate`` reports (not in the
+        paper: 0 there). It trains shape and magnitude together where they matter for
+        alpha(P*) (MODEL_CARD.md has the ablation).
     """
 
     epochs: int = 500
@@ -108,6 +123,10 @@ class TrainConfig:
 
 @dataclass(frozen=True)
 class TrainResult:
+    """What a training run did: its folder (``run_dir / "model.pt"`` is the best model), the
+    epochs run, the best epoch and its validation loss, whether early stopping ended it, and
+    the wall time [s]."""
+
     run_dir: Path
     epochs_run: int
     best_epoch: int

@@ -46,15 +46,34 @@ AREA_ESTIMATE = "subpixel-p2"
 class ValidationResult:
     """BEM against model for one design, at K loads on an M x M grid.
 
-    p_star: (K,) mean pressures P* = P / E*, ascending. alpha_bem, alpha_model: (K,);
-    alpha_bem_pixels: (K,) the BEM's plain count of grid points in contact.
-    p_max: (K,) largest local p / E*. asperity_alpha_bem / _model: (K, N) contact area of each
-    asperity / A_nom (model one None if the model does not resolve asperities). residual,
-    seconds: (K,) solver error and wall time per load. pressure: (M, M) p / E* at the
-    largest load. heights: the cell's HeightMap. model: the forward model compared with;
-    curve: its dense curve. pressures, gaps: (K, M, M) p / E* and the gap [length] at every
-    load, or None (kept when solved with ``fields=True``; written by ``write_result`` as
-    fields.nc).
+    Attributes
+    ----------
+    name, design, grid, model, tolerance, max_iter
+        What was checked, and how: the design's name and the design, M, the forward model
+        compared with, the solver's tolerance and iteration limit.
+    p_star : ndarray, shape (K,)
+        Mean pressures P* = P / E*, ascending.
+    alpha_bem, alpha_model : ndarray, shape (K,)
+        Contact-area fractions from the BEM (contact edges to sub-pixel accuracy) and the
+        model at those pressures.
+    alpha_bem_pixels : ndarray, shape (K,)
+        The BEM's plain count of grid points in contact, / M^2.
+    p_max : ndarray, shape (K,)
+        Largest local pressure p / E*.
+    asperity_alpha_bem, asperity_alpha_model : ndarray, shape (K, N)
+        Contact area of each asperity / A_nom (the model's None if the model does not
+        resolve asperities).
+    residual, seconds : ndarray, shape (K,)
+        Solver error and wall time [s] per load.
+    pressure : ndarray, shape (M, M)
+        p / E* at the largest load.
+    heights : HeightMap
+        The cell's height map.
+    curve : ModelCurve
+        The model's dense curve.
+    pressures, gaps : ndarray, shape (K, M, M), or None
+        p / E* and the gap [units of R] at every load, kept when solved with
+        ``fields=True`` (written by ``write_result`` as fields.nc).
     """
 
     name: str
@@ -102,12 +121,12 @@ class ValidationResult:
 
     @property
     def max_rel_err_upper(self) -> float:
-        """Largest |rel_err| over the upper half of the loads."""
+        """Largest abs(rel_err) over the upper half of the loads."""
         return float(np.abs(self.rel_err[self.upper_half]).max())
 
     @property
     def max_rel_err(self) -> float:
-        """Largest |rel_err| over all loads."""
+        """Largest abs(rel_err) over all loads."""
         return float(np.abs(self.rel_err).max())
 
     @property
