@@ -43,7 +43,10 @@ templates_path: list[str] = []
 # offline are ignored (no intersphinx: the build must not reach the network).
 nitpicky = True
 nitpick_ignore_regex = [
-    (r"py:.*", r"(numpy|np|torch|matplotlib|pathlib|os|abc|collections\.abc|typing|scipy|concurrent)\..*"),
+    (
+        r"py:.*",
+        r"(numpy|np|torch|matplotlib|pathlib|os|abc|collections\.abc|typing|scipy|concurrent)\..*",
+    ),
     (r"py:class", r"(Tensor|Axes|Figure|Path|PathLike|Sequence|Callable|Mapping)"),
 ]
 
