@@ -4,16 +4,34 @@ They know nothing of the domain (no physics, no designs), so the engine can chec
 stream results without importing the format layer (``metainterface.io``) above it.
 """
 
-from metainterface._files.atomic import atomic_open, ensure_parent, write_bytes, write_text
+from metainterface._files.atomic import (
+    atomic_open,
+    check_output_file,
+    check_output_folder,
+    ensure_parent,
+    output_set,
+    sweep_stale,
+    terminate_as_interrupt,
+    write_bytes,
+    write_text,
+)
 from metainterface._files.columns import read_columns, write_columns
 from metainterface._files.provenance import csv_header, provenance
+from metainterface._files.strict_json import dumps, finite_or_none
 
 __all__ = [
     "atomic_open",
+    "check_output_file",
+    "check_output_folder",
     "csv_header",
+    "dumps",
     "ensure_parent",
+    "finite_or_none",
+    "output_set",
     "provenance",
     "read_columns",
+    "sweep_stale",
+    "terminate_as_interrupt",
     "write_bytes",
     "write_columns",
     "write_text",

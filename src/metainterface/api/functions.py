@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
+from metainterface._files import check_output_file, check_output_folder
 from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline
@@ -31,7 +32,9 @@ from metainterface.physics.models import ForwardModel, get_model
 #: Upper bounds that keep a request within this machine's memory and a sane run time.
 MAX_STARTS = 10_000
 MAX_STEPS = 1_000_000
-MAX_SEED = 2**63 - 1
+MAX_SEED = _checks.MAX_SEED
+#: Asperity radius R of an export [m]: a nanometre to ten metres.
+RADIUS_RANGE = (1e-9, 10.0)
 #: Weight of the pressure-limit penalty added to the refinement's loss.
 PRESSURE_WEIGHT = 10.0
 
@@ -140,6 +143,8 @@ def design(
         One per target, in order.
     """
     items, single = _targets(targets)
+    if out is not None:  # before any work: a bad folder should not cost a design run
+        check_output_folder(out)
     _checks.choice("method", method, pipeline.METHODS)
     starts = _checks.whole("starts", starts, low=1, high=MAX_STARTS)
     hedge = _checks.whole("hedge", hedge, low=0, high=MAX_STARTS)
@@ -247,6 +252,8 @@ def compare(
     ``out/<target>/<method>/`` and the comparison figure to ``out/<target>/compare.png``.
     """
     items, _ = _targets(targets)
+    if out is not None:
+        check_output_folder(out)
     if "method" in options:
         raise MetainterfaceError("compare runs every method; leave method out")
     meta = options.pop("meta", None)
@@ -293,6 +300,12 @@ def _as_design(
         raise MetainterfaceError("give a design, or both gamma and h")
     if settings is not None and not isinstance(settings, CellSettings):
         raise MetainterfaceError("settings must be a CellSettings")
+    gamma, h = _checks.vector("gamma", gamma), _checks.vector("h", h)
+    if settings is not None and gamma.size != settings.n_asperities:
+        raise MetainterfaceError(
+            f"gamma has {gamma.size} values but settings.n_asperities is {settings.n_asperities}",
+            argument="gamma",
+        )
     return Design(gamma=gamma, h=h, settings=settings or CellSettings())
 
 
@@ -370,14 +383,21 @@ def export(
     """
     from metainterface.io.export import export_design
 
+    check_output_file(path)
     d = _as_design(design, None, None, None)
     if resolution is not None:
         resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
+    r = parse_length(radius, option="radius")
+    if not RADIUS_RANGE[0] <= r <= RADIUS_RANGE[1]:
+        raise MetainterfaceError(
+            f"radius must be between 1 nm and 10 m (1e-09 to 10 in metres), got {r:g} m",
+            argument="radius",
+        )
     source = str(design) if isinstance(design, str | os.PathLike) else None
     return export_design(
         d,
         path,
-        radius=parse_length(radius, option="radius"),
+        radius=r,
         tiles=tiles,
         fmt=format,
         resolution=resolution,

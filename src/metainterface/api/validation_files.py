@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
-from metainterface._files import provenance, write_columns, write_text
+from metainterface._files import provenance, strict_json, write_columns, write_text
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, get_model
@@ -195,7 +195,7 @@ def write_result(
         "seconds": [float(s) for s in result.seconds],
         "provenance": provenance(**settings),
     }
-    write_text(out / "result.json", json.dumps(record, indent=2) + "\n")
+    write_text(out / "result.json", strict_json.dumps(record, indent=2) + "\n")
     return out
 
 
@@ -292,7 +292,7 @@ def validate_many(
         ordered = {n: summaries[n] for n, _ in items if n in summaries}
         write_text(
             out / "summary.json",
-            json.dumps(
+            strict_json.dumps(
                 {"designs": ordered, "provenance": provenance(command="validate_many")}, indent=2
             )
             + "\n",

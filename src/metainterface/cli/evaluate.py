@@ -20,10 +20,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
 
     import metainterface as mi
-    from metainterface._files import provenance, write_text
+    from metainterface._files import provenance, strict_json, write_text
     from metainterface.surrogate.checkpoint import default_model_path
     from metainterface.surrogate.evaluate import format_table
 
@@ -37,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
             "dataset": args.dataset,
             "provenance": provenance(command="evaluate"),
         }
-        write_text(args.out, json.dumps(record, indent=2) + "\n")
+        write_text(args.out, strict_json.dumps(record, indent=2) + "\n")
     if args.plot:
         from metainterface.data import load_dataset
         from metainterface.plots import plot_reconstructions, save_figure

@@ -10,7 +10,6 @@ results.json (the same numbers, machine-readable, with the settings and provenan
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import sys
 import tempfile
@@ -22,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._files import strict_json
 from metainterface._files.atomic import write_text
 from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
@@ -146,7 +146,7 @@ def reproduce(
         "figures": ctx.figures,
         "paper": {k: {"value": v, "source": s} for k, (v, s) in PAPER.items()},
     }
-    write_text(out / "results.json", json.dumps(_jsonable(payload), indent=1) + "\n")
+    write_text(out / "results.json", strict_json.dumps(_jsonable(payload), indent=1) + "\n")
     if progress:
         print(f"reproduce: {len(ctx.figures)} figures and results.md in {out}", file=sys.stdout)
     return ReproduceResult(out, sc, numbers, dict(ctx.figures), seconds)
