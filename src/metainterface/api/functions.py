@@ -12,7 +12,7 @@ import numpy as np
 
 from metainterface import _checks
 from metainterface._files import check_output_file, check_output_folder
-from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve
+from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline
 from metainterface.inverse.refine import RefineSettings
@@ -394,7 +394,8 @@ def export(
             argument="radius",
         )
     source = str(design) if isinstance(design, str | os.PathLike) else None
-    return export_design(
+    notes = idle_notes(d)
+    record = export_design(
         d,
         path,
         radius=r,
@@ -404,6 +405,7 @@ def export(
         base=parse_length(base, option="base"),
         source=source,
     )
+    return {**record, "notes": list(notes)} if notes else record
 
 
 def physical(

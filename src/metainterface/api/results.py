@@ -40,6 +40,7 @@ class Curve:
     delta: (K,) global indentation Delta [units of R], from 0 to Delta_max.
     p_star: (K,) dimensionless pressure P* = P / E*. alpha: (K,) contact-area fraction
     A_real / A_nom. stiffness: (K,) S* = dP*/dalpha. model: the forward model's label.
+    notes: what the user should know about the result (asperities that never touch).
     """
 
     delta: np.ndarray
@@ -47,6 +48,7 @@ class Curve:
     alpha: np.ndarray
     stiffness: np.ndarray
     model: str = "independent"
+    notes: tuple[str, ...] = ()
 
     @property
     def p_star_max(self) -> float:
@@ -98,6 +100,18 @@ def design_curve(
         alpha=sw.alpha[0].numpy().copy(),
         stiffness=sw.stiffness[0].numpy().copy(),
         model=m.label,
+        notes=idle_notes(design),
+    )
+
+
+def idle_notes(design: Design) -> tuple[str, ...]:
+    """A note on the asperities more than Delta_max above the lowest tip, if any."""
+    idle = design.idle
+    if not idle.size:
+        return ()
+    return (
+        f"{idle.size} of {design.n_asperities} asperities (index {', '.join(map(str, idle))}) "
+        "sit more than Delta_max above the lowest tip and never touch",
     )
 
 

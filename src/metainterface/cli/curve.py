@@ -36,6 +36,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import sys
+
     import metainterface as mi
     from metainterface._files import write_columns
 
@@ -55,6 +57,8 @@ def run(args: argparse.Namespace) -> int:
         from metainterface.plots import plot_curve, save_figure
 
         save_figure(plot_curve(c, title=Path(args.design).name), args.plot, command="curve")
+    for note in c.notes:
+        print(f"warning: {note}", file=sys.stderr)
     print(
         f"{args.out}: {args.steps} points ({c.model}), "
         f"P*_max = {c.p_star_max:.4g}, alpha_max = {c.alpha_max:.4g}"

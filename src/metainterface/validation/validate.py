@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface import _checks
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, ModelCurve, get_model, models_at
@@ -193,13 +194,8 @@ def design_target(design: Design) -> tuple[np.ndarray, np.ndarray] | None:
         return None
     if not (isinstance(target, dict) and "p_star" in target and "alpha" in target):
         raise MetainterfaceError('target must be an object {"p_star": [...], "alpha": [...]}')
-    try:
-        p = np.asarray(target["p_star"], dtype=np.float64)
-        a = np.asarray(target["alpha"], dtype=np.float64)
-    except (TypeError, ValueError):
-        raise MetainterfaceError(
-            "target.p_star and target.alpha must be lists of numbers"
-        ) from None
+    p = _checks.vector("target.p_star", target["p_star"])
+    a = _checks.vector("target.alpha", target["alpha"])
     if p.ndim != 1 or p.shape != a.shape or p.size < 2:
         raise MetainterfaceError(
             "target.p_star and target.alpha must be lists of one length (>= 2 points)"
@@ -294,6 +290,11 @@ class ValidationPlan:
         )
 
 
+#: Loosest tolerance of the contact solve accepted: above it a "converged" solve is not a
+#: solution (the paper's is 1e-11; 1e-9 gives the same areas).
+MAX_TOLERANCE = 1e-6
+
+
 def plan_validation(
     design: Design,
     grid: int | None = None,
@@ -310,8 +311,7 @@ def plan_validation(
     """
     if isinstance(max_iter, bool) or not (isinstance(max_iter, int | np.integer) and max_iter >= 1):
         raise MetainterfaceError(f"max_iter must be a whole number >= 1, got {max_iter!r}")
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise MetainterfaceError(f"tolerance must be a number > 0, got {tolerance!r}")
+    tolerance = _checks.number("tolerance", tolerance, low=0.0, low_open=True, high=MAX_TOLERANCE)
     grid = default_grid(design.settings) if grid is None else check_grid(grid, design.settings)
     design_target(design)  # a malformed target fails now, not after the solve
     model = get_model(model)
