@@ -32,9 +32,13 @@ MEMORY_SHARE = 0.5
 def _range(low: float | None, high: float | None, low_open: bool, high_open: bool) -> str:
     lo = "(" if low_open or low is None else "["
     hi = ")" if high_open or high is None else "]"
-    return (
-        f"{lo}{'-inf' if low is None else f'{low:g}'}, {'inf' if high is None else f'{high:g}'}{hi}"
-    )
+
+    def show(x: float | None, inf: str) -> str:
+        if x is None:
+            return inf
+        return f"{x}" if isinstance(x, int) and abs(x) < 10**20 else f"{x:g}"
+
+    return f"{lo}{show(low, '-inf')}, {show(high, 'inf')}{hi}"
 
 
 def whole(name: str, value: Any, *, low: int | None = None, high: int | None = None) -> int:
@@ -142,7 +146,7 @@ def affordable(name: str, value: Any, nbytes: float, *, what: str = "") -> None:
     if nbytes > budget:
         raise MetainterfaceError(
             f"{name} = {value} would need about {_gib(nbytes)} of memory{what}, more than "
-            f"{_gib(budget)} (half of this machine's); lower {name}",
+            f"{_gib(budget)} (half of this machine's)",
             argument=name,
         )
 
@@ -159,6 +163,6 @@ def disk_room(name: str, value: Any, nbytes: float, folder: str | os.PathLike[st
     if nbytes > free:
         raise MetainterfaceError(
             f"{name} = {value} would write about {_gib(nbytes)}, more than the "
-            f"{_gib(free)} free on {here}; lower {name}",
+            f"{_gib(free)} free on {here}",
             argument=name,
         )

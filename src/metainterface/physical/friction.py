@@ -65,7 +65,7 @@ def read_friction_csv(path: str | os.PathLike[str]) -> FrictionLaw:
     if "friction_force" in header and "friction_coefficient" in header:
         raise MetainterfaceError(
             f"{path}: both friction_force and friction_coefficient columns; keep one "
-            "(they could disagree, and neither would be silently ignored)"
+            "(they could disagree, and one would be ignored)"
         )
     if "friction_force" in header:
         cols = read_columns(path, FORCE_COLUMNS)

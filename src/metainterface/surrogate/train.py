@@ -100,9 +100,8 @@ class TrainConfig:
             _checks.number(name, getattr(self, name), low=0.0, high=1e9)
         if not any(getattr(self, name) > 0 for name in weights):
             raise MetainterfaceError(
-                "w_shape, w_grad, w_mag and w_curve are all 0: the loss would be 0 and "
-                "nothing would be learned; make at least one > 0",
-                argument="w_shape",
+                "the loss weights w_shape, w_grad, w_mag and w_curve (--w-*) are all 0: "
+                "nothing would be learned; make at least one > 0"
             )
 
     @property
