@@ -19,7 +19,14 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
-from metainterface._files import provenance, strict_json, write_columns, write_text
+from metainterface._files import (
+    check_output_folder,
+    output_set,
+    provenance,
+    strict_json,
+    write_columns,
+    write_text,
+)
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, get_model
@@ -86,6 +93,8 @@ def validate(
         (``max_rel_err_upper``, ``target_errors()``).
     """
     require_tamaas()
+    if out is not None:  # before the solve: a bad folder should not cost a BEM run
+        check_output_folder(out)
     name = str(design) if isinstance(design, str | os.PathLike) else "design"
     if not isinstance(design, Design):
         if not isinstance(design, str | os.PathLike):
@@ -115,8 +124,9 @@ def validate(
     else:
         result = plan.solve(jobs)
     if out is not None:
-        write_result(result, out, command="validate", jobs=jobs)
-        write_models(result, Path(out) / "models.csv")
+        with output_set():  # all of a result's files, or none
+            write_result(result, out, command="validate", jobs=jobs)
+            write_models(result, Path(out) / "models.csv")
     return result
 
 
@@ -153,6 +163,7 @@ def result_settings(result: ValidationResult, **extra: Any) -> dict[str, Any]:
     }
 
 
+@output_set()  # a design's files go out together (a sweep resumes design by design)
 def write_result(
     result: ValidationResult, out_dir: str | os.PathLike[str], *, figure: bool = True, **extra: Any
 ) -> Path:

@@ -301,7 +301,7 @@ class Design:
         """Read and validate a design file; errors name the file and the field."""
         path = Path(path)
         try:
-            text = path.read_text(encoding="utf-8")
+            text = path.read_text(encoding="utf-8-sig")  # a BOM from a Windows editor is fine
         except FileNotFoundError:
             raise MetainterfaceError(f"{path}: file not found") from None
         except (OSError, UnicodeDecodeError) as exc:
