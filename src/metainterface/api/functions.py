@@ -402,7 +402,7 @@ def export(
         tiles=tiles,
         fmt=format,
         resolution=resolution,
-        base=parse_length(base, option="base"),
+        base=_checks.number("base", parse_length(base, option="base"), low=1e-6, high=1.0),
         source=source,
     )
     return {**record, "notes": list(notes)} if notes else record

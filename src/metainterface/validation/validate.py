@@ -166,15 +166,19 @@ def resolve_loads(loads: int | Sequence[float] | np.ndarray, p_star_max: float) 
     """The load path: K = ``loads`` uniform pressures P*_max i / K (i = 1..K), or the given
     P* values sorted. Every load must lie in (0, P*_max], P*_max reached at Delta_max."""
     if isinstance(loads, int | np.integer) and not isinstance(loads, bool):
-        if loads <= 0:
-            raise MetainterfaceError(f"loads must be a whole number > 0, got {loads}")
-        return p_star_max * np.arange(1, int(loads) + 1) / int(loads)
+        k = _checks.whole("loads", loads, low=1, high=MAX_LOADS)
+        return p_star_max * np.arange(1, k + 1) / k
     try:
         values = np.sort(np.asarray(loads, dtype=np.float64).ravel())
     except (TypeError, ValueError):
         raise MetainterfaceError("loads must be a count K or a list of pressures P*") from None
     if values.size == 0 or not np.isfinite(values).all():
         raise MetainterfaceError("loads must be a non-empty list of finite pressures P*")
+    if values.size > MAX_LOADS:
+        raise MetainterfaceError(
+            f"loads: {values.size} pressures, more than {MAX_LOADS} (each is a BEM solve)",
+            argument="loads",
+        )
     if values[0] <= 0:
         raise MetainterfaceError(
             f"loads: P* = {values[0]:g} is not > 0; allowed range (0, {p_star_max:.6g}]"
@@ -290,6 +294,8 @@ class ValidationPlan:
         )
 
 
+#: Most loads of one path: each is a full BEM solve (seconds to minutes on a fine grid).
+MAX_LOADS = 10_000
 #: Loosest tolerance of the contact solve accepted: above it a "converged" solve is not a
 #: solution (the paper's is 1e-11; 1e-9 gives the same areas).
 MAX_TOLERANCE = 1e-6
