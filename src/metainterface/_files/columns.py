@@ -52,8 +52,9 @@ def read_text_lines(path: str | os.PathLike[str]) -> list[str]:
         raise MetainterfaceError(f"{path}: cannot read ({exc.strerror})") from None
     if b"\0" in data:
         raise MetainterfaceError(f"{path}: binary data, expected a text (CSV) file")
+    data = data.removeprefix(b"\xef\xbb\xbf")
     try:
-        text = data.decode("utf-8-sig")
+        text = data.decode("utf-8")
     except UnicodeDecodeError:  # numbers and column names are ASCII: any 8-bit text will do
         text = data.decode("cp1252", errors="replace")
     return text.splitlines()
