@@ -74,6 +74,11 @@ def parse_quantity(
         text = str(value).strip()
         if not text:
             raise MetainterfaceError(f"{expect}, got an empty value", argument=option)
+        if not re.match(r"[-+]?(\d|\.\d|nan|inf)", text, re.IGNORECASE):  # pint: 'mm' = 1 mm
+            raise MetainterfaceError(
+                f"{expect}; cannot read {text!r} as a quantity: it does not start with a number",
+                argument=option,
+            )
         ureg = _registry()
         try:
             quantity = ureg.parse_expression(_normalise(text))
