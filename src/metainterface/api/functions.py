@@ -33,8 +33,27 @@ from metainterface.physics.models import ForwardModel, get_model
 MAX_STARTS = 10_000
 MAX_STEPS = 1_000_000
 MAX_SEED = _checks.MAX_SEED
-#: Asperity radius R of an export [m]: a nanometre to ten metres.
-RADIUS_RANGE = (1e-9, 10.0)
+#: Physical inputs in SI, with their units for messages: beyond these a number is a typo.
+PHYSICAL_RANGES = {
+    "radius": (1e-9, 10.0, "m"),
+    "modulus": (1e-3, 1e13, "Pa"),
+    "total_force": (1e-12, 1e12, "N"),
+    "area": (1e-18, 1e6, "m^2"),
+}
+#: Softplus steepness kappa_s [1/R]: below this the relaxed bracket is no longer a contact.
+SMOOTH_RANGE = (1.0, 1e15)
+
+
+def _physical(name: str, value: float) -> float:
+    low, high, unit = PHYSICAL_RANGES[name]
+    if not low <= value <= high:
+        raise MetainterfaceError(
+            f"{name} must be between {low:g} and {high:g} {unit}, got {value:g} {unit}",
+            argument=name,
+        )
+    return value
+
+
 #: Weight of the pressure-limit penalty added to the refinement's loss.
 PRESSURE_WEIGHT = 10.0
 
@@ -218,12 +237,12 @@ def _physical_options(radius: Any, modulus: Any, total_force: Any, area: Any) ->
     if total_force is not None and area is not None:
         raise MetainterfaceError("give total_force or area, not both")
     return {
-        "radius": parse_length(radius, option="radius"),
-        "e_star": parse_pressure(modulus, option="modulus"),
+        "radius": _physical("radius", parse_length(radius, option="radius")),
+        "e_star": _physical("modulus", parse_pressure(modulus, option="modulus")),
         "total_force": None
         if total_force is None
-        else parse_force(total_force, option="total_force"),
-        "area": None if area is None else parse_area(area, option="area"),
+        else _physical("total_force", parse_force(total_force, option="total_force")),
+        "area": None if area is None else _physical("area", parse_area(area, option="area")),
     }
 
 
@@ -334,7 +353,7 @@ def curve(
     steps : int
         Delta samples, in [2, 1000000].
     smooth : float
-        Softplus steepness kappa_s [1/R] instead of the exact bracket.
+        Softplus steepness kappa_s [1/R] instead of the exact bracket, in [1, 1e15].
 
     Returns
     -------
@@ -344,7 +363,7 @@ def curve(
     d = _as_design(design, gamma, h, settings)
     steps = _checks.whole("steps", steps, low=2, high=MAX_STEPS)
     if smooth is not None:
-        smooth = _checks.number("smooth", smooth, low=0.0, low_open=True)
+        smooth = _checks.number("smooth", smooth, low=SMOOTH_RANGE[0], high=SMOOTH_RANGE[1])
     return design_curve(d, model, steps=steps, smooth=smooth)
 
 
@@ -388,11 +407,7 @@ def export(
     if resolution is not None:
         resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
     r = parse_length(radius, option="radius")
-    if not RADIUS_RANGE[0] <= r <= RADIUS_RANGE[1]:
-        raise MetainterfaceError(
-            f"radius must be between 1 nm and 10 m (1e-09 to 10 in metres), got {r:g} m",
-            argument="radius",
-        )
+    _physical("radius", r)
     source = str(design) if isinstance(design, str | os.PathLike) else None
     notes = idle_notes(d)
     record = export_design(

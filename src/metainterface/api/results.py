@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import torch
 
+from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.limits import PressureCheck
@@ -94,6 +95,13 @@ def design_curve(
     with torch.no_grad():
         sw = m.design_sweep(design, n_delta=steps, smooth=smooth)
     delta = sw.delta if sw.delta.dim() == 1 else sw.delta[0]
+    for name in ("p_star", "alpha", "stiffness"):
+        if not torch.isfinite(getattr(sw, name)[0]).all():
+            raise MetainterfaceError(
+                f"the {m.label} model gives a non-finite {name} for this design"
+                + (f" with smooth = {smooth:g}" if smooth is not None else "")
+                + "; the curve would be wrong, so none is returned"
+            )
     return Curve(
         delta=delta.numpy().copy(),
         p_star=sw.p_star[0].numpy().copy(),
