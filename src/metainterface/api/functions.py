@@ -54,6 +54,9 @@ def _physical(name: str, value: float) -> float:
     return value
 
 
+#: Memory of one start per asperity during refinement (about twice what the multistart
+#: uses, so that a refusal is never wrong).
+BYTES_PER_START = 16 * 2**10
 #: Weight of the pressure-limit penalty added to the refinement's loss.
 PRESSURE_WEIGHT = 10.0
 
@@ -171,6 +174,10 @@ def design(
     seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
     if settings is not None and not isinstance(settings, CellSettings):
         raise MetainterfaceError("settings must be a CellSettings")
+    n = (settings or CellSettings()).n_asperities
+    _checks.affordable(
+        "starts", starts, (starts + hedge + fallback) * len(items) * n * BYTES_PER_START
+    )
     if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
         raise MetainterfaceError("refine_settings must be a RefineSettings")
     if not isinstance(refine, bool):
