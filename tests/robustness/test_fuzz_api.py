@@ -251,6 +251,8 @@ def api_cases(tmp):
         (lambda: mi.Target(p_star=[0, 1], alpha=[0, 0.1, 0.2]), "same length"),
         (lambda: mi.Target(p_star=[[0, 1, 2]], alpha=[[0, 0.1, 0.2]]), "1-D"),
         (lambda: mi.Target.builtin("magic"), "magic"),
+        (lambda: mi.Target(p_star=[0, 1e-3, 2e-3], alpha=[0, 0.01, 0.02], name="../x"), "name"),
+        (lambda: mi.validate(DESIGN, grid=16, jobs=10**6), "jobs"),
         (lambda: mi.CellSettings(delta_max=1e-300), "delta_max"),
         (lambda: mi.CellSettings(gamma_max=1e6), "gamma_max"),
         (lambda: mi.CellSettings(n_asperities=10**8), "n_asperities"),

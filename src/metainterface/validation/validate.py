@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import json
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -334,9 +335,9 @@ def plan_validation(
 
 
 def check_jobs(jobs: int) -> int:
-    if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs < 1:
-        raise MetainterfaceError(f"jobs must be a whole number >= 1, got {jobs!r}")
-    return int(jobs)
+    """Processes: at least 1, at most four per core (more only thrash, and a typo of
+    10000 would start 10000 processes)."""
+    return _checks.whole("jobs", jobs, low=1, high=4 * (os.cpu_count() or 1))
 
 
 # --- one design --------------------------------------------------------------------------
