@@ -103,6 +103,7 @@ def cases(d: str) -> list[tuple[list[str], str]]:
         (["curve", f"{d}/notjson.json", "--out", f"{o}.csv"], "malformed JSON"),
         (["curve", f"{d}/missing.json", "--out", f"{o}.csv"], "missing.json"),
         (["curve", f"{d}/design.json", "--out", ""], "output"),
+        ([*curve, "--plot", ""], "figure"),
         (["curve", f"{d}/design.json", "--out", f"{d}/fifo"], "fifo"),
         (["curve", f"{d}/design.json", "--out", f"{d}/link.csv"], "link.csv"),
         (["curve", f"{d}/design.json", "--out", f"{d}/afile/c.csv"], "afile"),
@@ -132,6 +133,7 @@ def cases(d: str) -> list[tuple[list[str], str]]:
         ([*gen, "--gamma-min", "5"], "gamma"),
         ([*gen, "--chunk", "0"], "--chunk"),
         ([*gen, "--plot", f"{o}.bogus"], "--plot"),
+        ([*gen, "--plot", ""], "--plot"),
         ([*gen[:5], "--out", "", "--quiet"], "output"),
         ([*gen[:5], "--out", f"{d}/out", "--quiet"], "out"),
         ([*gen[:5], "--out", f"{d}/afile/x.npz", "--quiet"], "afile"),
@@ -154,6 +156,7 @@ def cases(d: str) -> list[tuple[list[str], str]]:
         ([*train[:3], "--out", "", "--batch-size", "8"], "--out"),
         # evaluate: datasets and models
         (["evaluate", "--dataset", f"{d}/bad.npz"], "bad.npz"),
+        (["evaluate", "--dataset", f"{d}/small.npz", "--out", ""], "output"),
         (["evaluate", "--dataset", f"{d}/nan.npz"], "alpha_hat"),
         (["evaluate", "--dataset", f"{d}/tiny.npz"], "test split"),
         (["evaluate", "--dataset", f"{d}/small.npz", "--model", f"{d}/evil.pt"], "evil.pt"),

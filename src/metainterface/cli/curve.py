@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         smooth=args.smooth,
         model=c.model,
     )
-    if args.plot:
+    if args.plot is not None:
         from pathlib import Path
 
         from metainterface.plots import plot_curve, save_figure

@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
     model_path = args.model or default_model_path()
     result = mi.evaluate_surrogate(args.dataset, model_path)
     print(format_table(result))
-    if args.out:
+    if args.out is not None:
         record = {
             **result,
             "model": str(model_path),
@@ -37,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
             "provenance": provenance(command="evaluate"),
         }
         write_text(args.out, strict_json.dumps(record, indent=2) + "\n")
-    if args.plot:
+    if args.plot is not None:
         from metainterface.data import load_dataset
         from metainterface.plots import plot_reconstructions, save_figure
         from metainterface.surrogate.checkpoint import load_model
