@@ -30,7 +30,7 @@ def snapshot(folder: Path) -> dict[str, tuple[int, int, int]]:
 
 def run_cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, list[str]]:
     """Run the command line in this process: (exit status, stderr lines). argparse's own
-    exits are caught; signal handlers the CLI installs are put back."""
+    exits are caught; the signal handlers must be as they were."""
     saved = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
     capsys.readouterr()
     if os.environ.get("FUZZ_LOG"):  # which case ran, for a run that hangs or crashes
@@ -41,8 +41,7 @@ def run_cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, l
     except SystemExit as exc:
         rc = exc.code if isinstance(exc.code, int) else 1
     finally:
-        for s, h in saved.items():
-            signal.signal(s, h)
+        assert {s: signal.getsignal(s) for s in saved} == saved
     err = capsys.readouterr().err
     return rc, [line for line in err.splitlines() if line.strip()]
 

@@ -246,13 +246,21 @@ def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
     return Path(path)
 
 
-def terminate_as_interrupt() -> None:
-    """Make SIGTERM and SIGHUP raise KeyboardInterrupt in the main thread, as SIGINT does, so
-    that every temporary is removed on the way out. For entry points (the command line)."""
+@contextlib.contextmanager
+def terminate_as_interrupt() -> Iterator[None]:
+    """Inside the block, SIGTERM and SIGHUP raise KeyboardInterrupt in the main thread, as
+    SIGINT does, so that every temporary is removed on the way out; the previous handlers
+    come back after. For entry points (the command line)."""
 
     def handler(signum: int, frame: Any) -> None:
         raise KeyboardInterrupt(signal.Signals(signum).name)
 
-    if threading.current_thread() is threading.main_thread():
-        for sig in (signal.SIGTERM, signal.SIGHUP):
-            signal.signal(sig, handler)
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)

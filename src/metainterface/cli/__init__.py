@@ -74,10 +74,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     tune_allocator()
-    terminate_as_interrupt()
     whole = output_set() if args.command in ALL_OR_NOTHING else contextlib.nullcontext()
     try:
-        with whole:
+        with terminate_as_interrupt(), whole:
             return int(args.func(args) or 0)
     except MetainterfaceError as exc:
         message = " ".join(_as_option(parser, args.command, exc).split())
