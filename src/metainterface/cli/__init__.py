@@ -37,7 +37,7 @@ ALL_OR_NOTHING = frozenset({"design", "curve", "export", "generate", "evaluate"}
 
 #: Library argument names that a command's options spell differently.
 OPTION_NAMES = {
-    "design": {"model": "--physics", "surrogate": "--model", "settings": "--n-asperities"},
+    "design": {"model": "--physics", "surrogate": "--model"},
     "curve": {"model": "--physics"},
     "validate": {"model": "--physics"},
 }
