@@ -55,6 +55,7 @@ def inputs(tmp_path_factory: pytest.TempPathFactory) -> Path:
     variant("nested.json", h=[[0.0], [0.0], [0.0], [0.0]])
     variant("radius.json", radius="1")
     (d / "bom.json").write_bytes(b"\xef\xbb\xbf" + (d / "design.json").read_bytes())
+    (d / "deep.json").write_text("[" * 100_000, encoding="utf-8")
     (d / "notjson.json").write_text("{gamma: [2, 2", encoding="utf-8")
     rows = "0,0\n0.0005,0.01\n0.001,0.02\n"
     (d / "plain.csv").write_text("p_star,alpha\n" + rows)

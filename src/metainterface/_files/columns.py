@@ -37,6 +37,8 @@ def read_text_lines(path: str | os.PathLike[str]) -> list[str]:
     """The lines of a small text file as spreadsheets write it: UTF-8 with or without a byte
     order mark, else Windows-1252/Latin-1; any line ending. One-line errors."""
     path = Path(path)
+    if path.exists() and not path.is_file() and not path.is_dir():  # a FIFO would block
+        raise MetainterfaceError(f"{path}: not a regular file")
     try:
         if path.stat().st_size > MAX_TEXT_BYTES:
             raise MetainterfaceError(

@@ -301,6 +301,12 @@ class Design:
         """Read and validate a design file; errors name the file and the field."""
         path = Path(path)
         try:
+            if path.exists() and not path.is_file():  # a FIFO would block, a folder fail later
+                raise MetainterfaceError(f"{path}: not a regular file")
+            if path.stat().st_size > MAX_FILE_BYTES:
+                raise MetainterfaceError(
+                    f"{path}: {path.stat().st_size / 2**20:.0f} MiB, too large for a design file"
+                )
             text = path.read_text(encoding="utf-8-sig")  # a BOM from a Windows editor is fine
         except FileNotFoundError:
             raise MetainterfaceError(f"{path}: file not found") from None
@@ -312,6 +318,8 @@ class Design:
             raise MetainterfaceError(
                 f"{path}: malformed JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
             ) from None
+        except RecursionError:  # thousands of nested brackets
+            raise MetainterfaceError(f"{path}: JSON nested too deeply for a design file") from None
         return cls.from_dict(data, source=str(path))
 
     def save(self, path: str | os.PathLike[str], **extra: Any) -> Path:
@@ -322,6 +330,8 @@ class Design:
         return write_text(path, strict_json.dumps(data, indent=2) + "\n")
 
 
+#: Largest design file read (a design of the largest cell is well under 1 MiB).
+MAX_FILE_BYTES = 64 * 2**20
 #: The design file format every command reads and writes.
 FORMAT = "metainterface/design-v1"
 _CORE_KEYS = {"format", "gamma", "h", "radius", "delta_max", "gamma_bounds", "e_star"}
