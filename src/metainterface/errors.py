@@ -4,6 +4,16 @@ Every check on user input raises :class:`MetainterfaceError` with a message that
 field and the allowed range; the CLI turns it into a one-line message and exit status 2.
 """
 
+from __future__ import annotations
+
 
 class MetainterfaceError(ValueError):
-    """Invalid user input or an unrecoverable condition explained in one line."""
+    """Invalid user input or an unrecoverable condition explained in one line.
+
+    ``argument``, when set, is the Python name of the argument at fault (``"starts"``); the
+    command line shows it under its option name (``--starts``).
+    """
+
+    def __init__(self, message: str = "", *, argument: str | None = None) -> None:
+        super().__init__(message)
+        self.argument = argument

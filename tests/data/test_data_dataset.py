@@ -195,7 +195,7 @@ def test_load_missing_file(tmp_path):
 def test_load_not_a_npz(tmp_path):
     path = tmp_path / "text.npz"
     path.write_text("hello")
-    with pytest.raises(MetainterfaceError, match="not a readable"):
+    with pytest.raises(MetainterfaceError, match=r"not a \.npz dataset"):
         load_dataset(path)
 
 

@@ -40,7 +40,7 @@ def test_round_trip_keeps_extras_and_defaults(tmp_path):
         ({"gamma": [2.0, 2.0, 2.0, 0.9], "h": [0.0] * 4}, r"gamma\[3\] = 0.9 is outside"),
         ({"gamma": [2.0, 2.0, 2.0, 4.5], "h": [0.0] * 4}, r"bounds \[1.8, 4\]"),
         ({"gamma": [2.0] * 4, "h": [0.0, -1e-3, 0, 0]}, r"h\[1\] = -0.001 is negative"),
-        ({"gamma": [2.0] * 4, "h": [0.0, "x", 0, 0]}, "list of numbers"),
+        ({"gamma": [2.0] * 4, "h": [0.0, "x", 0, 0]}, r"h\[1\] must be a number"),
         ({"gamma": [2.0] * 4, "h": [0.0, 0, 0, float("nan")]}, r"h\[3\] is nan"),
         ({"gamma": [2.0] * 4, "h": [0.0] * 4, "format": "other/v9"}, "unknown format"),
         ({"gamma": [2.0] * 4, "h": [0.0] * 4, "gamma_bounds": [3, 2]}, "gamma_min < gamma_max"),

@@ -7,7 +7,12 @@ stream results without importing the format layer (``metainterface.io``) above i
 from metainterface._files.atomic import (
     atomic_open,
     atomic_path,
+    check_output_file,
+    check_output_folder,
     ensure_parent,
+    output_set,
+    sweep_stale,
+    terminate_as_interrupt,
     write_bytes,
     write_text,
 )
@@ -18,16 +23,24 @@ from metainterface._files.provenance import (
     provenance,
     short_hash,
 )
+from metainterface._files.strict_json import dumps, finite_or_none
 
 __all__ = [
     "atomic_open",
     "atomic_path",
+    "check_output_file",
+    "check_output_folder",
     "compact_provenance",
     "csv_header",
+    "dumps",
     "ensure_parent",
+    "finite_or_none",
+    "output_set",
     "provenance",
     "read_columns",
     "short_hash",
+    "sweep_stale",
+    "terminate_as_interrupt",
     "write_bytes",
     "write_columns",
     "write_text",

@@ -32,22 +32,58 @@ def write_columns(
     return write_text(path, buf.getvalue())
 
 
+#: Largest text file read whole (a CSV of this size holds millions of rows).
+MAX_TEXT_BYTES = 256 * 2**20
+
+
+def read_text_lines(path: str | os.PathLike[str]) -> list[str]:
+    """The lines of a small text file as spreadsheets write it: UTF-8 with or without a byte
+    order mark, else Windows-1252/Latin-1; any line ending. One-line errors."""
+    path = Path(path)
+    if path.exists() and not path.is_file() and not path.is_dir():  # a FIFO would block
+        raise MetainterfaceError(f"{path}: not a regular file")
+    try:
+        if path.stat().st_size > MAX_TEXT_BYTES:
+            raise MetainterfaceError(
+                f"{path}: {path.stat().st_size / 2**20:.0f} MiB, larger than the "
+                f"{MAX_TEXT_BYTES // 2**20} MiB a CSV may have"
+            )
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise MetainterfaceError(f"{path}: file not found") from None
+    except IsADirectoryError:
+        raise MetainterfaceError(f"{path}: is a folder, expected a CSV file") from None
+    except OSError as exc:
+        raise MetainterfaceError(f"{path}: cannot read ({exc.strerror})") from None
+    if b"\0" in data:
+        raise MetainterfaceError(f"{path}: binary data, expected a text (CSV) file")
+    data = data.removeprefix(b"\xef\xbb\xbf")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:  # numbers and column names are ASCII: any 8-bit text will do
+        text = data.decode("cp1252", errors="replace")
+    return text.splitlines()
+
+
+def _cell(text: str) -> str:
+    """A CSV cell without surrounding blanks or double quotes (spreadsheets add them)."""
+    text = text.strip()
+    if len(text) >= 2 and text[0] == text[-1] == '"':
+        text = text[1:-1].strip()
+    return text
+
+
 def read_columns(path: str | os.PathLike[str], required: Sequence[str]) -> dict[str, np.ndarray]:
     """Read a numeric CSV with a header row ('#' lines skipped); check required columns.
 
     Errors name the file, the row (1-based data row) or the missing column.
     """
     path = Path(path)
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError:
-        raise MetainterfaceError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MetainterfaceError(f"{path}: cannot read ({exc})") from None
+    lines = read_text_lines(path)
     rows = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")]
     if not rows:
         raise MetainterfaceError(f"{path}: empty file, expected a header {','.join(required)}")
-    header = [c.strip() for c in rows[0].split(",")]
+    header = [_cell(c) for c in rows[0].split(",")]
     missing = [c for c in required if c not in header]
     if missing:
         raise MetainterfaceError(
@@ -56,7 +92,7 @@ def read_columns(path: str | os.PathLike[str], required: Sequence[str]) -> dict[
         )
     values: list[list[float]] = []
     for i, line in enumerate(rows[1:], start=1):
-        cells = [c.strip() for c in line.split(",")]
+        cells = [_cell(c) for c in line.split(",")]
         if len(cells) != len(header):
             raise MetainterfaceError(
                 f"{path}: row {i} has {len(cells)} values, the header has {len(header)}"
@@ -64,6 +100,7 @@ def read_columns(path: str | os.PathLike[str], required: Sequence[str]) -> dict[
         try:
             values.append([float(c) for c in cells])
         except ValueError:
-            raise MetainterfaceError(f"{path}: row {i} is not numeric: {line!r}") from None
+            shown = line if len(line) <= 80 else line[:77] + "..."
+            raise MetainterfaceError(f"{path}: row {i} is not numeric: {shown!r}") from None
     arr = np.asarray(values, dtype=np.float64).reshape(-1, len(header))
     return {name: arr[:, header.index(name)] for name in required}

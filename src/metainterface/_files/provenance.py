@@ -18,6 +18,8 @@ from typing import Any
 
 import torch
 
+from metainterface._files import strict_json
+
 #: Longest JSON text of one setting kept as is; longer ones are replaced by their hash.
 MAX_INLINE = 200
 #: Hex digits of the short hashes (64 bits: collisions are no concern for a record).
@@ -68,4 +70,4 @@ def csv_header(*, stamp: bool = True, **settings: Any) -> str:
     """A '# ' comment line for CSV files (numpy and pandas(comment='#') skip it), its
     settings compacted (:func:`compact_provenance`)."""
     record = compact_provenance(stamp=stamp, **settings)
-    return "# " + json.dumps(record, sort_keys=True, default=str) + "\n"
+    return "# " + strict_json.dumps(record, sort_keys=True, default=str) + "\n"

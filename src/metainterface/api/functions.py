@@ -12,7 +12,8 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
-from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve
+from metainterface._files import check_output_file, check_output_folder, output_set
+from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline
 from metainterface.inverse.perturb import Perturbation
@@ -33,7 +34,31 @@ from metainterface.physics.models import ForwardModel, get_model
 #: Upper bounds that keep a request within this machine's memory and a sane run time.
 MAX_STARTS = 10_000
 MAX_STEPS = 1_000_000
-MAX_SEED = 2**63 - 1
+MAX_SEED = _checks.MAX_SEED
+#: Physical inputs in SI, with their units for messages: beyond these a number is a typo.
+PHYSICAL_RANGES = {
+    "radius": (1e-9, 10.0, "m"),
+    "modulus": (1e-3, 1e13, "Pa"),
+    "total_force": (1e-12, 1e12, "N"),
+    "area": (1e-18, 1e6, "m^2"),
+}
+#: Softplus steepness kappa_s [1/R]: below this the relaxed bracket is no longer a contact.
+SMOOTH_RANGE = (1.0, 1e15)
+
+
+def _physical(name: str, value: float) -> float:
+    low, high, unit = PHYSICAL_RANGES[name]
+    if not low <= value <= high:
+        raise MetainterfaceError(
+            f"{name} must be between {low:g} and {high:g} {unit}, got {value:g} {unit}",
+            argument=name,
+        )
+    return value
+
+
+#: Memory of one start per asperity during refinement (about twice what the multistart
+#: uses, so that a refusal is never wrong).
+BYTES_PER_START = 16 * 2**10
 #: Weight of the pressure-limit penalty added to the refinement's loss.
 PRESSURE_WEIGHT = 10.0
 
@@ -168,6 +193,8 @@ def design(
         One per target, in order.
     """
     items, single = _targets(targets)
+    if out is not None:  # before any work: a bad folder should not cost a design run
+        check_output_folder(out)
     _checks.choice("method", method, pipeline.METHODS)
     starts = _checks.whole("starts", starts, low=1, high=MAX_STARTS)
     hedge = _checks.whole("hedge", hedge, low=0, high=MAX_STARTS)
@@ -175,6 +202,10 @@ def design(
     seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
     if settings is not None and not isinstance(settings, CellSettings):
         raise MetainterfaceError("settings must be a CellSettings")
+    n = (settings or CellSettings()).n_asperities
+    _checks.affordable(
+        "starts", starts, (starts + hedge + fallback) * len(items) * n * BYTES_PER_START
+    )
     if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
         raise MetainterfaceError("refine_settings must be a RefineSettings")
     if not isinstance(refine, bool):
@@ -347,12 +378,12 @@ def _physical_options(radius: Any, modulus: Any, total_force: Any, area: Any) ->
     if total_force is not None and area is not None:
         raise MetainterfaceError("give total_force or area, not both")
     return {
-        "radius": parse_length(radius, option="radius"),
-        "e_star": parse_pressure(modulus, option="modulus"),
+        "radius": _physical("radius", parse_length(radius, option="radius")),
+        "e_star": _physical("modulus", parse_pressure(modulus, option="modulus")),
         "total_force": None
         if total_force is None
-        else parse_force(total_force, option="total_force"),
-        "area": None if area is None else parse_area(area, option="area"),
+        else _physical("total_force", parse_force(total_force, option="total_force")),
+        "area": None if area is None else _physical("area", parse_area(area, option="area")),
     }
 
 
@@ -363,11 +394,12 @@ def _save_all(
     meta: dict[str, Any] | None,
     full_target: bool = False,
 ) -> None:
-    for r, folder in zip(results, folders, strict=True):
-        extra = {"command": meta} if meta else {}
-        if physical is not None:
-            extra["physical"] = physical_block(r.design, **physical)
-        r.save(folder, full_target=full_target, **extra)
+    with output_set():  # every result's files, or none
+        for r, folder in zip(results, folders, strict=True):
+            extra = {"command": meta} if meta else {}
+            if physical is not None:
+                extra["physical"] = physical_block(r.design, **physical)
+            r.save(folder, full_target=full_target, **extra)
 
 
 def compare(
@@ -383,6 +415,8 @@ def compare(
     (one target: ``out/<method>/`` and ``out/compare.png``).
     """
     items, single = _targets(targets)
+    if out is not None:
+        check_output_folder(out)
     if "method" in options:
         raise MetainterfaceError("compare runs every method; leave method out")
     meta = options.pop("meta", None)
@@ -401,12 +435,13 @@ def compare(
         from metainterface.plots import plot_comparison, save_figure
 
         out = Path(out)
-        for i, t in enumerate(items):
-            per = [by_method[m][i] for m in pipeline.METHODS]
-            base = out if single else out / t.name
-            _save_all(per, [base / r.method for r in per], physical, meta, full_target)
-            fig = plot_comparison([per], [[r.curve() for r in per]])
-            save_figure(fig, base / "compare.png", command="compare")
+        with output_set():  # all methods' files and figures, or none
+            for i, t in enumerate(items):
+                per = [by_method[m][i] for m in pipeline.METHODS]
+                base = out if single else out / t.name
+                _save_all(per, [base / r.method for r in per], physical, meta, full_target)
+                fig = plot_comparison([per], [[r.curve() for r in per]])
+                save_figure(fig, base / "compare.png", command="compare")
     return by_method  # type: ignore[return-value]
 
 
@@ -431,6 +466,12 @@ def _as_design(
         raise MetainterfaceError("give a design, or both gamma and h")
     if settings is not None and not isinstance(settings, CellSettings):
         raise MetainterfaceError("settings must be a CellSettings")
+    gamma, h = _checks.vector("gamma", gamma), _checks.vector("h", h)
+    if settings is not None and gamma.size != settings.n_asperities:
+        raise MetainterfaceError(
+            f"gamma has {gamma.size} values but settings.n_asperities is {settings.n_asperities}",
+            argument="gamma",
+        )
     return Design(gamma=gamma, h=h, settings=settings or CellSettings())
 
 
@@ -459,7 +500,7 @@ def curve(
     steps : int
         Delta samples, in [2, 1000000].
     smooth : float
-        Softplus steepness kappa_s [1/R] instead of the exact bracket.
+        Softplus steepness kappa_s [1/R] instead of the exact bracket, in [1, 1e15].
 
     Returns
     -------
@@ -469,7 +510,7 @@ def curve(
     d = _as_design(design, gamma, h, settings)
     steps = _checks.whole("steps", steps, low=2, high=MAX_STEPS)
     if smooth is not None:
-        smooth = _checks.number("smooth", smooth, low=0.0, low_open=True)
+        smooth = _checks.number("smooth", smooth, low=SMOOTH_RANGE[0], high=SMOOTH_RANGE[1])
     return design_curve(d, model, steps=steps, smooth=smooth)
 
 
@@ -514,11 +555,13 @@ def export(
     """
     from metainterface.io.export import export_design
 
+    check_output_file(path)
     d = _as_design(design, None, None, None)
     if resolution is not None:
         resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
-    source = str(design) if isinstance(design, str | os.PathLike) else None
     radius_m = parse_length(radius, option="radius")
+    _physical("radius", radius_m)
+    source = str(design) if isinstance(design, str | os.PathLike) else None
     step = None
     if z_step is not None:
         from metainterface.api.tolerance import length_in_r
@@ -528,7 +571,8 @@ def export(
             raise MetainterfaceError(
                 f"z_step must be in (0, Delta_max = {d.settings.delta_max:g} R], got {step:g} R"
             )
-    return export_design(
+    notes = idle_notes(d)
+    record = export_design(
         d,
         path,
         z_step=step,
@@ -536,9 +580,10 @@ def export(
         tiles=tiles,
         fmt=format,
         resolution=resolution,
-        base=parse_length(base, option="base"),
+        base=_checks.number("base", parse_length(base, option="base"), low=1e-6, high=1.0),
         source=source,
     )
+    return {**record, "notes": list(notes)} if notes else record
 
 
 def physical(

@@ -12,6 +12,7 @@ import numpy as np
 import torch
 
 from metainterface._files.provenance import HASH_DIGITS
+from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.limits import PressureCheck
@@ -56,6 +57,8 @@ class Curve:
         S* = dP*/dalpha.
     model : str
         The forward model's label.
+    notes : tuple of str
+        What the user should know about the result (asperities that never touch).
     """
 
     delta: np.ndarray
@@ -63,6 +66,7 @@ class Curve:
     alpha: np.ndarray
     stiffness: np.ndarray
     model: str = "independent"
+    notes: tuple[str, ...] = ()
 
     @property
     def p_star_max(self) -> float:
@@ -124,12 +128,31 @@ def design_curve(
         else:
             sw = m.design_sweep(design, n_delta=steps, smooth=smooth)
     delta = sw.delta if sw.delta.dim() == 1 else sw.delta[0]
+    for name in ("p_star", "alpha", "stiffness"):
+        if not torch.isfinite(getattr(sw, name)[0]).all():
+            raise MetainterfaceError(
+                f"the {m.label} model gives a non-finite {name} for this design"
+                + (f" with smooth = {smooth:g}" if smooth is not None else "")
+                + "; the curve would be wrong, so none is returned"
+            )
     return Curve(
         delta=delta.numpy().copy(),
         p_star=sw.p_star[0].numpy().copy(),
         alpha=sw.alpha[0].numpy().copy(),
         stiffness=sw.stiffness[0].numpy().copy(),
         model=m.label,
+        notes=idle_notes(design),
+    )
+
+
+def idle_notes(design: Design) -> tuple[str, ...]:
+    """A note on the asperities more than Delta_max above the lowest tip, if any."""
+    idle = design.idle
+    if not idle.size:
+        return ()
+    return (
+        f"{idle.size} of {design.n_asperities} asperities (index {', '.join(map(str, idle))}) "
+        "sit more than Delta_max above the lowest tip and never touch",
     )
 
 

@@ -10,7 +10,6 @@ within a budget (the design's heights scale with R, the printer's error does not
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import os
 import time
@@ -22,7 +21,7 @@ import numpy as np
 import torch
 
 from metainterface import _checks
-from metainterface._files import provenance, write_columns, write_text
+from metainterface._files import provenance, strict_json, write_columns, write_text
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import tolerance as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
@@ -236,7 +235,7 @@ class ToleranceResult:
         record = self.settings.to_dict()
         write_columns(folder / "band.csv", self.band(), stamp=False, command="tolerance", **record)
         data = {**self.summary(), **extra, "provenance": provenance(command="tolerance", **record)}
-        write_text(folder / "tolerance.json", json.dumps(data, indent=2, default=str) + "\n")
+        write_text(folder / "tolerance.json", strict_json.dumps(data, indent=2, default=str) + "\n")
         save_figure(self.plot(), folder / "tolerance.png", command="tolerance", **record)
         return folder
 

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 from pathlib import Path
 from typing import Any
 
 from metainterface import _checks
+from metainterface._files import check_output_file, check_output_folder
 from metainterface.data import generate_dataset as _generate
 from metainterface.data import load_dataset
 from metainterface.data.dataset import DEFAULT_CHUNK, GenerationReport
@@ -35,9 +38,15 @@ def generate_dataset(
     ``out`` (.npz). The same (samples, seed, settings) give the same arrays; ``chunk``
     (samples computed together) changes memory, not results."""
     samples = _checks.whole("samples", samples, low=1, high=MAX_SAMPLES)
-    seed = _checks.whole("seed", seed, low=0, high=2**63 - 1)
+    seed = _checks.seed(seed)
     chunk = _checks.whole("chunk", chunk, low=1, high=1_000_000)
-    return _generate(samples, seed, settings or CellSettings(), out, progress=progress, chunk=chunk)
+    settings = settings or CellSettings()
+    out = check_output_file(out)
+    row = 8 * 2 * settings.n_asperities + 4 * (2 * settings.n_steps + 2) + 16
+    _checks.disk_room("samples", samples, samples * row, out.parent)
+    # a chunk's curves, in flight on a few threads, with the sweep's working arrays
+    _checks.affordable("chunk", chunk, 8 * chunk * row)
+    return _generate(samples, seed, settings, out, progress=progress, chunk=chunk)
 
 
 def train_surrogate(
@@ -51,7 +60,9 @@ def train_surrogate(
     """Train the inverse network on a dataset (``generate_dataset``) into the run folder
     ``out``: one atomic checkpoint per epoch (``resume=True`` continues), the best model as
     ``out/model.pt``, usable as ``design(..., surrogate=out / "model.pt")``."""
+    check_output_folder(out)
     ds = load_dataset(dataset)
+    fingerprint = hashlib.sha256(json.dumps(ds.meta, sort_keys=True).encode()).hexdigest()[:16]
     return train(
         split_of(ds, "train"),
         split_of(ds, "val"),
@@ -60,7 +71,12 @@ def train_surrogate(
         config,
         resume=resume,
         progress=progress,
-        dataset_info={"path": str(dataset), "samples": len(ds), "seed": ds.seed},
+        dataset_info={
+            "path": str(dataset),
+            "samples": len(ds),
+            "seed": ds.seed,
+            "fingerprint": fingerprint,
+        },
     )
 
 

@@ -33,7 +33,15 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
-from metainterface._files import csv_header, provenance, write_columns, write_text
+from metainterface._files import (
+    check_output_folder,
+    csv_header,
+    output_set,
+    provenance,
+    strict_json,
+    write_columns,
+    write_text,
+)
 from metainterface.api.cluster import check_scheduler, dask_executor
 from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, open_fields, require_xarray, write_fields
@@ -115,6 +123,8 @@ def validate(
         (``max_rel_err_upper``, ``target_errors()``).
     """
     require_tamaas()
+    if out is not None:  # before the solve: a bad folder should not cost a BEM run
+        check_output_folder(out)
     if fields and out is not None:
         require_xarray()  # before the solve, not after it
     if executor is not None and scheduler is not None:
@@ -157,8 +167,9 @@ def validate(
             fields=fields,
         )
     if out is not None:
-        write_result(result, out, command="validate", jobs=jobs)
-        write_models(result, Path(out) / "models.csv")
+        with output_set():  # all of a result's files, or none
+            write_result(result, out, command="validate", jobs=jobs)
+            write_models(result, Path(out) / "models.csv")
     return result
 
 
@@ -195,6 +206,7 @@ def result_settings(result: ValidationResult, **extra: Any) -> dict[str, Any]:
     }
 
 
+@output_set()  # a design's files go out together (a sweep resumes design by design)
 def write_result(
     result: ValidationResult, out_dir: str | os.PathLike[str], *, figure: bool = True, **extra: Any
 ) -> Path:
@@ -242,7 +254,7 @@ def write_result(
         "seconds": [float(s) for s in result.seconds],
         "provenance": provenance(**settings),
     }
-    write_text(out / "result.json", json.dumps(record, indent=2) + "\n")
+    write_text(out / "result.json", strict_json.dumps(record, indent=2) + "\n")
     return out
 
 
@@ -503,7 +515,7 @@ def validate_many(
         ordered = {n: summaries[n] for n, _ in items if n in summaries}
         _write_summary(out, [summary_row(n, s) for n, s in ordered.items()], **sweep)
         record = {"designs": ordered, "provenance": provenance(**sweep)}
-        write_text(out / "summary.json", json.dumps(record, indent=2) + "\n")
+        write_text(out / "summary.json", strict_json.dumps(record, indent=2) + "\n")
 
     # one design's chunks: (design index in todo, its tasks); flat list for the engine
     tasks, owner = [], []

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from metainterface._files import strict_json
 from metainterface._files.atomic import write_text
 from metainterface.api.results import DesignResult, design_curve
 from metainterface.errors import MetainterfaceError
@@ -229,7 +229,7 @@ def _files(source: Any, folder: Path | None, page: Path, record: dict[str, Any])
     if folder is None:
         design = source.design if isinstance(source, DesignResult) else source
         extra = record if isinstance(source, DesignResult) else {}
-        data = (json.dumps(design.to_dict(**extra), indent=2) + "\n").encode("utf-8")
+        data = (strict_json.dumps(design.to_dict(**extra), indent=2) + "\n").encode("utf-8")
         return [{"name": "design.json", "size": len(data), "data": data}]
     out, total = [], 0
     for f in sorted(folder.iterdir()):

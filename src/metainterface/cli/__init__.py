@@ -3,6 +3,10 @@
 Each subcommand lives in its own module here with ``register(subparsers)``, which adds its
 parser and sets ``func`` to a ``run(args) -> int`` function. Modules import heavy libraries
 inside ``run`` so that ``--help`` stays fast.
+
+Every failure a user can cause ends in one line on stderr and exit status 2: argparse's own
+errors too (no usage block), and the library's errors name the option as typed (``--starts``,
+not ``starts``). SIGTERM and SIGHUP end a run like Ctrl-C (exit 130), temporaries removed.
 """
 
 from __future__ import annotations
@@ -11,6 +15,7 @@ import argparse
 import importlib
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 from metainterface.errors import MetainterfaceError
 
@@ -28,11 +33,31 @@ COMMANDS: tuple[str, ...] = (
     "view",
 )
 
+#: Commands whose files are written as one set, all or none (the others write as they go,
+#: so that an interrupted run resumes: train's checkpoints, reproduce's stages, a sweep).
+#: design's files are one set inside mi.design / mi.compare already, so that --html can
+#: read them back to make the page (a file staged in a set is not there yet).
+ALL_OR_NOTHING = frozenset({"curve", "export", "generate", "evaluate"})
+
+#: Library argument names that a command's options spell differently.
+OPTION_NAMES = {
+    "design": {"model": "--physics", "surrogate": "--model"},
+    "curve": {"model": "--physics"},
+    "validate": {"model": "--physics"},
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``metainterface design: error: argument --starts: ...``."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {' '.join(message.split())}\n")
+
 
 def build_parser() -> argparse.ArgumentParser:
     from metainterface import __version__
 
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="metainterface",
         description="Inverse design of tribological metainterfaces (alpha(P*) contact laws).",
     )
@@ -45,19 +70,39 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit status (2 for bad input, with a one-line message)."""
+    import contextlib
+
+    from metainterface._files import output_set, terminate_as_interrupt
     from metainterface.runtime import tune_allocator
 
     parser = build_parser()
     args = parser.parse_args(argv)
     tune_allocator()
+    whole = output_set() if args.command in ALL_OR_NOTHING else contextlib.nullcontext()
     try:
-        return int(args.func(args) or 0)
+        with terminate_as_interrupt(), whole:
+            return int(args.func(args) or 0)
     except MetainterfaceError as exc:
-        print(f"metainterface {args.command}: error: {exc}", file=sys.stderr)
+        message = " ".join(_as_option(parser, args.command, exc).split())
+        print(f"metainterface {args.command}: error: {message}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print(f"metainterface {args.command}: error: out of memory", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"metainterface {args.command}: interrupted", file=sys.stderr)
         return 130
+
+
+def _as_option(parser: argparse.ArgumentParser, command: str, exc: MetainterfaceError) -> str:
+    """The error's message with its argument named as the command's option, if it has one."""
+    message, name = str(exc), exc.argument
+    if not name or not message.startswith(name):
+        return message
+    option = OPTION_NAMES.get(command, {}).get(name, "--" + name.replace("_", "-"))
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    known = {s for a in sub.choices[command]._actions for s in a.option_strings}
+    return option + message[len(name) :] if option in known else message
 
 
 if __name__ == "__main__":  # pragma: no cover

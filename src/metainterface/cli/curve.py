@@ -36,6 +36,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import sys
+
     import metainterface as mi
     from metainterface._files import write_columns
 
@@ -49,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         smooth=args.smooth,
         model=c.model,
     )
-    if args.plot:
+    if args.plot is not None:
         from pathlib import Path
 
         from metainterface.plots import plot_curve, save_figure
@@ -57,6 +59,8 @@ def run(args: argparse.Namespace) -> int:
         path = Path(args.design)  # "FOLDER: design.json": the file name alone is often the same
         title = f"{path.parent.name}: {path.name}" if path.parent.name else path.name
         save_figure(plot_curve(c, title=title), args.plot, command="curve")
+    for note in c.notes:
+        print(f"warning: {note}", file=sys.stderr)
     print(
         f"{args.out}: {args.steps} points ({c.model}), "
         f"P*_max = {c.p_star_max:.4g}, alpha_max = {c.alpha_max:.4g}"

@@ -20,25 +20,24 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
 
     import metainterface as mi
-    from metainterface._files import provenance, write_text
+    from metainterface._files import provenance, strict_json, write_text
     from metainterface.surrogate.checkpoint import default_model_path
     from metainterface.surrogate.evaluate import format_table
 
     model_path = args.model or default_model_path()
     result = mi.evaluate_surrogate(args.dataset, model_path)
     print(format_table(result))
-    if args.out:
+    if args.out is not None:
         record = {
             **result,
             "model": str(model_path),
             "dataset": args.dataset,
             "provenance": provenance(command="evaluate"),
         }
-        write_text(args.out, json.dumps(record, indent=2) + "\n")
-    if args.plot:
+        write_text(args.out, strict_json.dumps(record, indent=2) + "\n")
+    if args.plot is not None:
         from metainterface.data import load_dataset
         from metainterface.plots import plot_reconstructions, save_figure
         from metainterface.surrogate.checkpoint import load_model

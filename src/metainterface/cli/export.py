@@ -42,6 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import sys
+
     import metainterface as mi
     from metainterface.physical import parse_length
 
@@ -66,6 +68,8 @@ def run(args: argparse.Namespace) -> int:
         base=parse_length(args.base, option="--base"),
         z_step=_z_step(args),
     )
+    for note in rec.get("notes", ()):
+        print(f"warning: {note}", file=sys.stderr)
     nx, ny = rec["tiles"]
     size = f"{rec['size_m'][0] * 1e3:.4g} x {rec['size_m'][1] * 1e3:.4g} mm"
     detail = f"{rec['grid_per_cell']} points per cell side ({rec['points_per_mm']:.4g}/mm)"

@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
         gamma_min=_float("--gamma-min", args.gamma_min),
         gamma_max=_float("--gamma-max", args.gamma_max),
     )
-    if args.plot and Path(args.plot).suffix.lower() not in _FIGURE_SUFFIXES:
+    if args.plot is not None and Path(args.plot).suffix.lower() not in _FIGURE_SUFFIXES:
         raise MetainterfaceError(
             f"--plot {args.plot}: unknown suffix {Path(args.plot).suffix!r}, "
             f"use one of {', '.join(_FIGURE_SUFFIXES)}"
@@ -88,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
     report = mi.generate_dataset(
         samples, args.out, seed=seed, settings=settings, progress=not args.quiet, chunk=chunk
     )
-    if args.plot:
+    if args.plot is not None:
         from metainterface.plots import plot_dataset_examples, save_figure
 
         labels = {c.name: c.label for c in CATEGORIES}

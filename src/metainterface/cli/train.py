@@ -96,11 +96,11 @@ def run(args: argparse.Namespace) -> int:
 
     from metainterface.errors import MetainterfaceError
 
-    if args.plot:
+    if args.plot is not None:
         from metainterface.plots import plot_training, save_figure
         from metainterface.surrogate.train import read_metrics
 
-        fig_path = args.figure or str(Path(args.plot) / "training.png")
+        fig_path = args.figure if args.figure is not None else str(Path(args.plot) / "training.png")
         save_figure(plot_training(read_metrics(args.plot)), fig_path, command="train --plot")
         print(f"{fig_path}: training panels of {args.plot}")
         return 0

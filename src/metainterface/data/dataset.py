@@ -351,6 +351,7 @@ def generate_dataset(
                 nonlocal pos
                 curves = job.result()
                 k = len(cat)
+                check_curves(curves, settings, first_row=pos)
                 split = labels[pos : pos + k]
                 writer.write("gamma", gamma)
                 writer.write("h", h)
@@ -394,6 +395,23 @@ def generate_dataset(
         seconds=time.perf_counter() - started,
         examples=example_arrays,
     )
+
+
+def check_curves(curves: Mapping[str, np.ndarray], settings: CellSettings, first_row: int) -> None:
+    """Refuse curves that are not finite, or whose scales are not positive (float32 underflow
+    or overflow for an extreme cell): a dataset never holds a silent NaN."""
+    for name in _CURVE_ARRAYS:
+        values = np.asarray(curves[name])
+        bad = ~np.isfinite(values)
+        if name in ("p_star_max", "alpha_max"):
+            bad |= ~(values > 0)
+        if bad.any():
+            row = first_row + int(np.flatnonzero(bad.reshape(len(values), -1).any(axis=1))[0])
+            raise MetainterfaceError(
+                f"sample {row}: {name} is not a finite positive number in float32 for this cell "
+                f"(delta_max {settings.delta_max:g}, radius {settings.radius:g}, gamma in "
+                f"[{settings.gamma_min:g}, {settings.gamma_max:g}]); nothing written"
+            )
 
 
 # -- loading --------------------------------------------------------------------------------
@@ -453,6 +471,16 @@ def load_dataset(path: str | os.PathLike[str], settings: CellSettings | None = N
     if not path.is_file():
         raise MetainterfaceError(f"{path}: file not found")
     try:
+        with path.open("rb") as fh:
+            magic = fh.read(4)
+    except OSError as exc:
+        raise MetainterfaceError(f"{path}: cannot read ({exc.strerror})") from None
+    if magic != b"PK\x03\x04":  # np.load would try .npy and pickle content next
+        raise MetainterfaceError(
+            f"{path}: not a .npz dataset (not a zip archive); make one with "
+            "`metainterface generate`"
+        )
+    try:
         with np.load(path, allow_pickle=False) as npz:
             missing = [name for name in ARRAYS if name not in npz.files]
             if missing:
@@ -464,7 +492,8 @@ def load_dataset(path: str | os.PathLike[str], settings: CellSettings | None = N
     except MetainterfaceError:
         raise
     except Exception as exc:  # zipfile.BadZipFile, ValueError, OSError, ...
-        raise MetainterfaceError(f"{path}: not a readable .npz dataset ({exc})") from None
+        first = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise MetainterfaceError(f"{path}: not a readable .npz dataset ({first})") from None
 
     try:
         meta = json.loads(str(arrays.pop("meta")[()]))
@@ -507,6 +536,20 @@ def load_dataset(path: str | os.PathLike[str], settings: CellSettings | None = N
             raise MetainterfaceError(
                 f"{path}: array {name} holds unknown value {str(bad[0])!r}, "
                 f"expected {', '.join(allowed)}"
+            )
+
+    for name in ("gamma", "h", *_CURVE_ARRAYS):
+        if arrays[name].dtype.kind not in "fiu":
+            raise MetainterfaceError(f"{path}: array {name} is not numeric")
+        bad = ~np.isfinite(arrays[name])
+        if name in ("p_star_max", "alpha_max"):
+            bad |= ~(arrays[name] > 0)
+        if bad.any():
+            row = int(np.flatnonzero(bad.reshape(s, -1).any(axis=1))[0])
+            raise MetainterfaceError(
+                f"{path}: row {row} of {name} is not a finite"
+                f"{' positive' if name in ('p_star_max', 'alpha_max') else ''} number; "
+                "the dataset cannot be used"
             )
 
     if settings is not None:

@@ -67,6 +67,11 @@ class Target:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
             raise MetainterfaceError(f"target name must be a non-empty string, got {self.name!r}")
+        if self.name in (".", "..") or any(c in self.name for c in "/\\\0"):
+            # the name becomes an output folder: it must not point elsewhere
+            raise MetainterfaceError(
+                f"target name {self.name!r} cannot name a folder (no '/', '\\', '.' or '..')"
+            )
         where = f"target {self.name}"
         p = _column(where, "p_star", self.p_star)
         a = _column(where, "alpha", self.alpha)

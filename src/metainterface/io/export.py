@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._files import strict_json
 from metainterface._files.atomic import write_bytes, write_text
 from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
@@ -215,11 +216,30 @@ def patch_mesh(patch: Patch, base: float) -> Any:
     mesh = trimesh.Trimesh(
         vertices=np.concatenate([top, bottom, centre]), faces=faces, process=False
     )
-    # Outward winding (positive volume) is fixed by construction and tested; closure is
-    # checked on every mesh.
-    if not (mesh.is_watertight and mesh.is_winding_consistent):
-        raise RuntimeError("internal error: the STL mesh is not closed and consistently wound")
+    # Outward winding (positive volume) is fixed by construction and tested; closure, and
+    # what the file will hold (float32 millimetres), are checked on every mesh.
+    check_mesh(mesh)
     return mesh
+
+
+def check_mesh(mesh: Any) -> None:
+    """Refuse an STL that would be wrong: coordinates not finite in float32 (the STL's
+    type), triangles of zero area at that precision, not closed, or of no volume."""
+    v32 = np.asarray(mesh.vertices, dtype=np.float64).astype(np.float32)
+    if not np.isfinite(v32).all():
+        raise MetainterfaceError(
+            "the STL's coordinates are not finite in single precision; check --radius and "
+            "the design's heights"
+        )
+    tri = v32[np.asarray(mesh.faces)].astype(np.float64)
+    area2 = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    if len(mesh.faces) == 0 or not (area2 > 0).all():
+        raise MetainterfaceError(
+            f"the STL has {int((area2 <= 0).sum())} triangles of zero area in single precision;"
+            " check --radius and --resolution"
+        )
+    if not (mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0):
+        raise MetainterfaceError("the STL mesh is not closed and consistently wound; not written")
 
 
 def _quantise(heights: np.ndarray) -> tuple[np.ndarray, dict[str, float]]:
@@ -302,6 +322,8 @@ def export_design(
     tiles = parse_tiles(tiles)
     grid = None if resolution is None else grid_for_resolution(design, radius, resolution)
     patch = height_patch(design, radius=radius, tiles=tiles, grid=grid)
+    if not np.isfinite(patch.heights).all() or not np.isfinite(patch.spacing) or patch.spacing <= 0:
+        raise MetainterfaceError("the height map is not finite; check --radius and the heights")
     size = patch.size
     record: dict[str, Any] = {
         "file": out.name,
@@ -353,7 +375,7 @@ def export_design(
         base_m=float(base) if fmt == "stl" else None,
         z_step=z_step,
     )
-    write_text(sidecar_path(out), json.dumps(record, indent=2) + "\n")
+    write_text(sidecar_path(out), strict_json.dumps(record, indent=2) + "\n")
     return record
 
 

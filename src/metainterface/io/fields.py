@@ -17,7 +17,6 @@ line y = i * spacing, as in the height map. Open it with ``xarray.open_dataset(p
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from types import ModuleType
@@ -25,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from metainterface._files import strict_json
 from metainterface._files.atomic import atomic_path
 from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
@@ -108,7 +108,7 @@ def fields_dataset(result: ValidationResult, **settings: Any) -> Any:
             "design": result.name,
             "grid": result.grid,
             "length_units": units,
-            "provenance": json.dumps(provenance(**settings), default=str),
+            "provenance": strict_json.dumps(provenance(**settings), default=str),
         },
     )
     return ds

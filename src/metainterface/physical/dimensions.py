@@ -33,6 +33,10 @@ def _positive(name: str, value: float | None) -> float | None:
     return value
 
 
+#: Most unit cells an interface may hold (a square metre of 1 um cells is 1e12).
+MAX_CELLS = 1e15
+
+
 def physical_block(
     design: Design,
     *,
@@ -84,5 +88,13 @@ def physical_block(
     elif a_m2 is not None:
         out.update(area_m2=a_m2, n_cells=a_m2 / side**2, force_at_pressure_max_n=pressure * a_m2)
     if "n_cells" in out:
-        out["tiles_per_side"] = int(np.ceil(math.sqrt(out["n_cells"]) - 1e-9))
+        n_cells = out["n_cells"]
+        if not (math.isfinite(n_cells) and 1.0 <= n_cells <= MAX_CELLS):
+            what = "total_force" if f_n is not None else "area"
+            raise MetainterfaceError(
+                f"{what} gives {n_cells:.3g} unit cells of side {side:.3g} m; it must give "
+                f"between 1 and {MAX_CELLS:g}",
+                argument=what,
+            )
+        out["tiles_per_side"] = int(np.ceil(math.sqrt(n_cells) - 1e-9))
     return out

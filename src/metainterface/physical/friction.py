@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from metainterface._files.columns import read_columns
+from metainterface._files.columns import read_columns, read_text_lines
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 
@@ -48,15 +48,9 @@ class FrictionLaw:
 
 
 def _header(path: Path) -> list[str]:
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError:
-        raise MetainterfaceError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MetainterfaceError(f"{path}: cannot read ({exc})") from None
-    for line in lines:
+    for line in read_text_lines(path):
         if line.strip() and not line.lstrip().startswith("#"):
-            return [c.strip() for c in line.split(",")]
+            return [c.strip().strip('"').strip() for c in line.split(",")]
     return []
 
 
@@ -68,6 +62,11 @@ def read_friction_csv(path: str | os.PathLike[str]) -> FrictionLaw:
     """
     path = Path(path)
     header = _header(path)
+    if "friction_force" in header and "friction_coefficient" in header:
+        raise MetainterfaceError(
+            f"{path}: both friction_force and friction_coefficient columns; keep one "
+            "(they could disagree, and one would be ignored)"
+        )
     if "friction_force" in header:
         cols = read_columns(path, FORCE_COLUMNS)
         friction = cols["friction_force"]

@@ -67,20 +67,27 @@ def parse_quantity(
         f"{option} expects {article} {dimension} (e.g. {example}; a plain number is in {si_unit})"
     )
     if isinstance(value, bool):
-        raise MetainterfaceError(f"{expect}, got {value!r}")
+        raise MetainterfaceError(f"{expect}, got {value!r}", argument=option)
     if isinstance(value, int | float):
         si = float(value)
     else:
         text = str(value).strip()
         if not text:
-            raise MetainterfaceError(f"{expect}, got an empty value")
+            raise MetainterfaceError(f"{expect}, got an empty value", argument=option)
+        if not re.match(r"[-+]?(\d|\.\d|nan|inf)", text, re.IGNORECASE):  # pint: 'mm' = 1 mm
+            raise MetainterfaceError(
+                f"{expect}; cannot read {text!r} as a quantity: it does not start with a number",
+                argument=option,
+            )
         ureg = _registry()
         try:
             quantity = ureg.parse_expression(_normalise(text))
         # pint's expression parser raises many unrelated types on malformed text (PintError,
         # SyntaxError, TokenError, AssertionError, IndexError, ZeroDivisionError, ...).
         except Exception:
-            raise MetainterfaceError(f"{expect}; cannot read {text!r} as a quantity") from None
+            raise MetainterfaceError(
+                f"{expect}; cannot read {text!r} as a quantity", argument=option
+            ) from None
         if not isinstance(quantity, ureg.Quantity):  # a plain number: SI
             si = float(quantity)
         elif quantity.dimensionless:
@@ -93,9 +100,9 @@ def parse_quantity(
                 f"not that of {article} {dimension}"
             )
     if not math.isfinite(si):
-        raise MetainterfaceError(f"{option} must be finite, got {value!r}")
+        raise MetainterfaceError(f"{option} must be finite, got {value!r}", argument=option)
     if positive and si <= 0:
-        raise MetainterfaceError(f"{option} must be > 0, got {value!r}")
+        raise MetainterfaceError(f"{option} must be > 0, got {value!r}", argument=option)
     return si
 
 
@@ -140,13 +147,15 @@ def parse_pressure_limit(
         if not (math.isfinite(ratio) and 0 < ratio <= 1):
             raise MetainterfaceError(
                 f"{option} {text} read as p/E* must be in (0, 1]; give a stress with a unit "
-                f"(e.g. 50MPa) together with {modulus_option}"
+                f"(e.g. 50MPa) together with {modulus_option}",
+                argument=option,
             )
         return ratio
     stress = parse_pressure(text, option=option)
     if e_star is None:
         raise MetainterfaceError(
-            f"{option} {text} is a stress: give {modulus_option} (E*) too, or the limit as p/E*"
+            f"{option} {text} is a stress: give {modulus_option} (E*) too, or the limit as p/E*",
+            argument=option,
         )
     if not (math.isfinite(e_star) and e_star > 0):
         raise MetainterfaceError(f"{modulus_option} must be > 0, got {e_star}")

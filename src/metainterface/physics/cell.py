@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from metainterface._files import strict_json
 from metainterface._files.atomic import write_text
 from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
@@ -27,17 +28,31 @@ from metainterface.physics.sneddon import contact_radius
 # Resolution of the gamma scan that finds a_max; the maximum is at an end point for all
 # practical settings, the scan only guards against exotic ones (Delta_max ~ R).
 _A_MAX_SCAN = 4097
+#: Bounds that keep the closed forms in floating-point range (Gamma(gamma/2 + 1) overflows
+#: near gamma = 340; Delta_max / R below 1e-9 underflows the areas) and sizes sane.
+GAMMA_LIMIT = 100.0
+DELTA_RATIO = (1e-9, 1.0)
+SCALE_LIMITS = (1e-12, 1e12)
+MAX_ASPERITIES = 10_000
+MAX_STEPS = 1_000_000
+#: Anchored heights above this many Delta_max are refused as absurd; an asperity between
+#: Delta_max and this is legitimate but never touches (Design.idle).
+H_LIMIT = 1000.0
 
 
 def _finite(name: str, value: float, *, low: float | None = None, strict: bool = True) -> float:
+    if isinstance(value, str | bool):  # float("2") would pass a string number silently
+        raise MetainterfaceError(f"{name} must be a number, got {value!r}", argument=name)
     try:
         value = float(value)
-    except (TypeError, ValueError):
-        raise MetainterfaceError(f"{name} must be a number, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise MetainterfaceError(f"{name} must be a number, got {value!r}", argument=name) from None
     if not math.isfinite(value):
-        raise MetainterfaceError(f"{name} must be finite, got {value}")
+        raise MetainterfaceError(f"{name} must be finite, got {value}", argument=name)
     if low is not None and (value <= low if strict else value < low):
-        raise MetainterfaceError(f"{name} must be {'>' if strict else '>='} {low}, got {value}")
+        raise MetainterfaceError(
+            f"{name} must be {'>' if strict else '>='} {low}, got {value}", argument=name
+        )
     return value
 
 
@@ -75,22 +90,52 @@ class CellSettings:
             raise MetainterfaceError(f"n_asperities must be a positive perfect square, got {n!r}")
         if math.isqrt(int(n)) ** 2 != n:
             raise MetainterfaceError(
-                f"n_asperities must be a perfect square (1, 4, 9, 16, ...), got {n}"
+                f"n_asperities must be a perfect square (1, 4, 9, 16, ...), got {n}",
+                argument="n_asperities",
+            )
+        if n > MAX_ASPERITIES:
+            raise MetainterfaceError(
+                f"n_asperities must be at most {MAX_ASPERITIES}, got {n}", argument="n_asperities"
             )
         object.__setattr__(self, "n_asperities", int(n))
         for name in ("radius", "e_star", "delta_max"):
             object.__setattr__(self, name, _finite(name, getattr(self, name), low=0.0))
+        for name in ("radius", "e_star"):
+            value = getattr(self, name)
+            if not SCALE_LIMITS[0] <= value <= SCALE_LIMITS[1]:
+                raise MetainterfaceError(
+                    f"{name} must be in [{SCALE_LIMITS[0]:g}, {SCALE_LIMITS[1]:g}], got {value:g}",
+                    argument=name,
+                )
+        ratio = self.delta_max / self.radius
+        if not DELTA_RATIO[0] <= ratio <= DELTA_RATIO[1]:
+            raise MetainterfaceError(
+                f"delta_max must be in [{DELTA_RATIO[0]:g}, {DELTA_RATIO[1]:g}] R (small-slope "
+                f"contact, floating-point range), got {ratio:g} R",
+                argument="delta_max",
+            )
         gmin = _finite("gamma_min", self.gamma_min, low=1.0)
         gmax = _finite("gamma_max", self.gamma_max, low=1.0)
         if gmax <= gmin:
             raise MetainterfaceError(
                 f"gamma bounds must satisfy 1 < gamma_min < gamma_max, got [{gmin}, {gmax}]"
             )
+        if gmax > GAMMA_LIMIT:
+            raise MetainterfaceError(
+                f"gamma_max must be at most {GAMMA_LIMIT:g}, got {gmax:g}", argument="gamma_max"
+            )
         object.__setattr__(self, "gamma_min", gmin)
         object.__setattr__(self, "gamma_max", gmax)
         steps = self.n_steps
-        if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 2:
-            raise MetainterfaceError(f"n_steps must be an integer >= 2, got {steps!r}")
+        if (
+            isinstance(steps, bool)
+            or not isinstance(steps, int | np.integer)
+            or not 2 <= steps <= MAX_STEPS
+        ):
+            raise MetainterfaceError(
+                f"n_steps must be an integer in [2, {MAX_STEPS}], got {steps!r}",
+                argument="n_steps",
+            )
         object.__setattr__(self, "n_steps", int(steps))
 
     @property
@@ -179,12 +224,24 @@ class Design:
         if bad.size:
             i = int(bad[0])
             raise MetainterfaceError(f"h[{i}] = {h[i]:g} is negative; heights must be >= 0")
+        bad = np.flatnonzero(h - h.min() > H_LIMIT * s.delta_max)
+        if bad.size:
+            i = int(bad[0])
+            raise MetainterfaceError(
+                f"h[{i}] = {h[i]:g} lies {(h[i] - h.min()) / s.delta_max:.3g} Delta_max above the "
+                f"lowest tip; heights must be within {H_LIMIT:g} Delta_max of it"
+            )
         object.__setattr__(self, "gamma", np.clip(gamma, s.gamma_min, s.gamma_max))
         object.__setattr__(self, "h", h)
 
     @property
     def n_asperities(self) -> int:
         return int(self.gamma.size)
+
+    @property
+    def idle(self) -> np.ndarray:
+        """Indices of the asperities that never touch: more than Delta_max above the lowest."""
+        return np.flatnonzero(self.h - self.h.min() > self.settings.delta_max * (1 + 1e-12))
 
     def tensors(self, dtype: torch.dtype = torch.float64) -> tuple[torch.Tensor, torch.Tensor]:
         """(gamma, h) as (1, N) tensors: a batch of one for the physics functions."""
@@ -259,7 +316,13 @@ class Design:
         """Read and validate a design file; errors name the file and the field."""
         path = Path(path)
         try:
-            text = path.read_text(encoding="utf-8")
+            if path.exists() and not path.is_file():  # a FIFO would block, a folder fail later
+                raise MetainterfaceError(f"{path}: not a regular file")
+            if path.stat().st_size > MAX_FILE_BYTES:
+                raise MetainterfaceError(
+                    f"{path}: {path.stat().st_size / 2**20:.0f} MiB, too large for a design file"
+                )
+            text = path.read_text(encoding="utf-8-sig")  # a BOM from a Windows editor is fine
         except FileNotFoundError:
             raise MetainterfaceError(f"{path}: file not found") from None
         except (OSError, UnicodeDecodeError) as exc:
@@ -270,6 +333,8 @@ class Design:
             raise MetainterfaceError(
                 f"{path}: malformed JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
             ) from None
+        except RecursionError:  # thousands of nested brackets
+            raise MetainterfaceError(f"{path}: JSON nested too deeply for a design file") from None
         return cls.from_dict(data, source=str(path))
 
     def save(self, path: str | os.PathLike[str], **extra: Any) -> Path:
@@ -277,22 +342,17 @@ class Design:
         one); ``extra`` keys are stored beside the design. Returns the path."""
         data = self.to_dict(**extra)
         data.setdefault("provenance", provenance())
-        return write_text(path, json.dumps(data, indent=2) + "\n")
+        return write_text(path, strict_json.dumps(data, indent=2) + "\n")
 
 
+#: Largest design file read (a design of the largest cell is well under 1 MiB).
+MAX_FILE_BYTES = 64 * 2**20
 #: The design file format every command reads and writes.
 FORMAT = "metainterface/design-v1"
 _CORE_KEYS = {"format", "gamma", "h", "radius", "delta_max", "gamma_bounds", "e_star"}
 
 
 def _as_vector(name: str, values: Any) -> np.ndarray:
-    try:
-        arr = np.asarray(values, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise MetainterfaceError(f"{name} must be a list of numbers") from None
-    if arr.ndim != 1 or arr.size == 0:
-        raise MetainterfaceError(f"{name} must be a non-empty 1-D list of numbers")
-    bad = np.flatnonzero(~np.isfinite(arr))
-    if bad.size:
-        raise MetainterfaceError(f"{name}[{int(bad[0])}] is {arr[bad[0]]}; values must be finite")
-    return arr
+    from metainterface._checks import vector
+
+    return vector(name, values)

@@ -5,7 +5,6 @@ tick labels that never run together)."""
 from __future__ import annotations
 
 import io
-import json
 import math
 import os
 from pathlib import Path
@@ -15,6 +14,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, MaxNLocator, ScalarFormatter
 
+from metainterface._files import strict_json
 from metainterface._files.atomic import write_bytes
 from metainterface._files.provenance import compact_provenance
 from metainterface.errors import MetainterfaceError
@@ -98,7 +98,7 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], **settings: Any) -> P
         raise MetainterfaceError(
             f"figure {path}: unknown suffix {path.suffix!r}, use one of {', '.join(_FORMATS)}"
         )
-    record = json.dumps(compact_provenance(**settings), default=str)
+    record = strict_json.dumps(compact_provenance(**settings), default=str)
     meta = {
         "png": {"Software": "metainterface", "Description": record},
         "pdf": {"Creator": "metainterface", "Subject": record},

@@ -10,7 +10,6 @@ results.json (the same numbers, machine-readable, with the settings and provenan
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import sys
 import tempfile
@@ -22,7 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from metainterface._files.atomic import write_text
+from metainterface._files import strict_json
+from metainterface._files.atomic import check_output_folder, write_text
 from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
 from metainterface.reproduce.scales import PAPER, SCALES, Scale, get_scale
@@ -97,9 +97,9 @@ def reproduce(
 
     sc = get_scale(scale, quick)
     names = stages.plan(list(only) if only else None)
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise MetainterfaceError(f"--out {out} is a file, expected a folder")
+    out = check_output_folder(out_dir)
+    if work_dir is not None:
+        check_output_folder(work_dir)
     model = Path(model_path) if model_path else default_model_path()
     if not model.is_file():
         raise MetainterfaceError(f"model {model}: file not found")
@@ -146,7 +146,7 @@ def reproduce(
         "figures": ctx.figures,
         "paper": {k: {"value": v, "source": s} for k, (v, s) in PAPER.items()},
     }
-    write_text(out / "results.json", json.dumps(_jsonable(payload), indent=1) + "\n")
+    write_text(out / "results.json", strict_json.dumps(_jsonable(payload), indent=1) + "\n")
     if progress:
         print(f"reproduce: {len(ctx.figures)} figures and results.md in {out}", file=sys.stdout)
     return ReproduceResult(out, sc, numbers, dict(ctx.figures), seconds)

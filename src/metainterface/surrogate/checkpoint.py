@@ -31,15 +31,18 @@ def save_torch(path: str | os.PathLike[str], obj: Any) -> Path:
 def load_torch(path: str | os.PathLike[str], what: str = "file") -> Any:
     """torch.load with weights_only=True; one-line errors for missing or foreign files."""
     path = Path(path)
+    if path.is_dir():
+        raise MetainterfaceError(f"{what} {path}: is a folder, expected a file")
     if not path.is_file():
         raise MetainterfaceError(f"{what} {path}: file not found")
     try:
         return torch.load(path, map_location="cpu", weights_only=True)
     except Exception as exc:  # corrupt, truncated or unsafe content
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise MetainterfaceError(
-            f"{what} {path}: not a readable weights file ({first[:120]})"
-        ) from None
+        if "weights only" in str(exc).lower():  # torch's long advice to unpickle: never
+            why = "it holds Python objects beyond tensors, which are never unpickled"
+        else:
+            why = "not a PyTorch file, or a truncated or corrupt one"
+        raise MetainterfaceError(f"{what} {path}: not a readable weights file ({why})") from None
 
 
 def save_model(path: str | os.PathLike[str], model: InverseMLP, config: dict[str, Any]) -> Path:

@@ -9,6 +9,7 @@ import torch
 from torch import Tensor
 
 from metainterface.data.dataset import Dataset
+from metainterface.errors import MetainterfaceError
 from metainterface.physics.curves import features_from_normalised
 from metainterface.surrogate.loss import CurveTargets
 
@@ -44,8 +45,14 @@ class Split:
 
 
 def split_of(dataset: Dataset, name: str) -> Split:
-    """The rows of a loaded dataset whose split is ``name`` (train, val or test)."""
+    """The rows of a loaded dataset whose split is ``name`` (train, val or test); a split
+    with no rows is a one-line error (too few samples to split)."""
     sub = dataset.subset(name)
+    if len(sub) == 0:
+        where = f"{dataset.path}: " if dataset.path is not None else ""
+        raise MetainterfaceError(
+            f"{where}the {name} split is empty ({len(dataset)} samples); generate more samples"
+        )
 
     def f32(a: np.ndarray) -> Tensor:
         return torch.as_tensor(a, dtype=torch.float32)

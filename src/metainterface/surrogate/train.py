@@ -15,7 +15,6 @@ so it is comparable across epochs while kappa_s anneals.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import time
@@ -27,7 +26,9 @@ import numpy as np
 import torch
 from tqdm.auto import tqdm
 
-from metainterface._files.atomic import write_text
+from metainterface import _checks
+from metainterface._files import strict_json
+from metainterface._files.atomic import output_set, write_text
 from metainterface._files.columns import write_columns
 from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
@@ -93,17 +94,30 @@ class TrainConfig:
     w_curve: float = 300.0
 
     def __post_init__(self) -> None:
-        for name in ("epochs", "batch_size", "physics_steps"):
-            if getattr(self, name) < (2 if name != "epochs" else 1):
-                raise MetainterfaceError(f"{name} must be >= {2 if name != 'epochs' else 1}")
-        if not (self.lr > 0 and math.isfinite(self.lr)):
-            raise MetainterfaceError(f"lr must be > 0, got {self.lr}")
-        for name in ("w_shape", "w_grad", "w_mag", "w_curve"):
-            value = getattr(self, name)
-            if not (value >= 0 and math.isfinite(value)):
-                raise MetainterfaceError(f"{name} must be a finite number >= 0, got {value}")
-        if self.patience < 1:
-            raise MetainterfaceError(f"patience must be >= 1, got {self.patience}")
+        big = 1_000_000  # epochs, batches, steps: beyond this a run would not end
+        for name, low, high in (
+            ("epochs", 1, big),
+            ("batch_size", 2, 100 * big),
+            ("physics_steps", 2, 100_000),
+            ("patience", 1, big),
+            ("curriculum_epochs", 0, big),
+        ):
+            _checks.whole(name, getattr(self, name), low=low, high=high)
+        _checks.seed(self.seed)
+        _checks.number("lr", self.lr, low=0.0, low_open=True, high=10.0)
+        _checks.number("weight_decay", self.weight_decay, low=0.0, high=10.0)
+        _checks.number("lambda_start", self.lambda_start, low=0.0, high=1e6)
+        _checks.number("kappa_start", self.kappa_start, low=0.0, low_open=True, high=1e12)
+        _checks.number("kappa_end", self.kappa_end, low=0.0, low_open=True, high=1e12)
+        _checks.number("kappa_fraction", self.kappa_fraction, low=0.0, high=1.0)
+        weights = ("w_shape", "w_grad", "w_mag", "w_curve")
+        for name in weights:
+            _checks.number(name, getattr(self, name), low=0.0, high=1e9)
+        if not any(getattr(self, name) > 0 for name in weights):
+            raise MetainterfaceError(
+                "the loss weights w_shape, w_grad, w_mag and w_curve (--w-*) are all 0: "
+                "nothing would be learned; make at least one > 0"
+            )
 
     @property
     def weights(self) -> LossWeights:
@@ -196,9 +210,13 @@ def train(
             raise MetainterfaceError(f"--resume: no checkpoint in {out}")
         state = load_torch(ckpt_path, "checkpoint")
         if state["config"] != asdict(config):
+            changed = sorted(k for k, v in asdict(config).items() if state["config"].get(k, v) != v)
+            was = ", ".join(f"{k} {state['config'].get(k)!r}" for k in changed)
             raise MetainterfaceError(
-                f"--resume: {ckpt_path} was made with other settings: {state['config']}"
+                f"--resume: {ckpt_path} was made with other settings ({was}); give the "
+                "same options or another --out"
             )
+        _same_dataset(ckpt_path, state.get("dataset"), dataset_info)
         model.load_state_dict(state["model"])
         opt.load_state_dict(state["optimizer"])
         sched.load_state_dict(state["scheduler"])
@@ -219,7 +237,7 @@ def train(
         "dataset": dataset_info or {},
         "provenance": provenance(),
     }
-    write_text(out / "config.json", json.dumps(run_info, indent=2, default=str) + "\n")
+    write_text(out / "config.json", strict_json.dumps(run_info, indent=2, default=str) + "\n")
     schedules = config.schedules
     n = len(train_split)
     t_run = time.perf_counter()
@@ -270,33 +288,54 @@ def train(
                 "seconds": time.perf_counter() - t0,
             }
         )
-        if val < best:
-            best, best_epoch, bad = val, epoch + 1, 0
-            save_model(out / "model.pt", model, {**run_info, "epoch": epoch + 1, "val_loss": val})
-        else:
-            bad += 1
-        save_torch(
-            ckpt_path,
-            {
-                "config": asdict(config),
-                "model": model.state_dict(),
-                "optimizer": opt.state_dict(),
-                "scheduler": sched.state_dict(),
-                "rng": torch.get_rng_state(),
-                "epoch": epoch + 1,
-                "best": best,
-                "best_epoch": best_epoch,
-                "bad": bad,
-                "history": history,
-            },
-        )
-        write_metrics(out / "metrics.csv", history)
+        if not math.isfinite(run_loss):
+            raise MetainterfaceError(
+                f"training diverged at epoch {epoch + 1} (training loss {run_loss}); lower --lr"
+            )
+        with output_set():  # an epoch's files go out together: a kill loses one epoch at most
+            if val < best:
+                best, best_epoch, bad = val, epoch + 1, 0
+                save_model(
+                    out / "model.pt", model, {**run_info, "epoch": epoch + 1, "val_loss": val}
+                )
+            else:
+                bad += 1
+            save_torch(
+                ckpt_path,
+                {
+                    "config": asdict(config),
+                    "dataset": dataset_info or {},
+                    "model": model.state_dict(),
+                    "optimizer": opt.state_dict(),
+                    "scheduler": sched.state_dict(),
+                    "rng": torch.get_rng_state(),
+                    "epoch": epoch + 1,
+                    "best": best,
+                    "best_epoch": best_epoch,
+                    "bad": bad,
+                    "history": history,
+                },
+            )
+            write_metrics(out / "metrics.csv", history)
         bar.set_postfix(train=f"{run_loss / batches:.4f}", val=f"{val:.4f}", kappa=f"{kappa:.0f}")
         if bad >= config.patience:
             stopped = True
             break
     bar.close()
     return TrainResult(out, len(history), best_epoch, best, stopped, time.perf_counter() - t_run)
+
+
+def _same_dataset(ckpt_path: Path, stored: dict | None, given: dict | None) -> None:
+    """--resume must continue on the dataset the run started with."""
+    if not stored or not given:
+        return
+    keys = ("fingerprint", "samples", "seed")
+    if any(k in stored and k in given and stored[k] != given[k] for k in keys):
+        raise MetainterfaceError(
+            f"--resume: {ckpt_path} was trained on another dataset ({stored.get('path')}, "
+            f"{stored.get('samples')} samples, seed {stored.get('seed')}); give that --dataset "
+            "or another --out"
+        )
 
 
 def write_metrics(path: Path, history: list[dict[str, float]]) -> None:

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._process import die_with_parent
 from metainterface.errors import MetainterfaceError
 
 #: Convergence tolerance of the Polonsky-Keer-Rey solver (the paper's value).
@@ -221,8 +222,9 @@ def solve_path(
 _progress_queue: Any = None
 
 
-def _init_worker(queue: Any) -> None:
+def _init_worker(queue: Any, parent: int | None = None) -> None:
     global _progress_queue
+    die_with_parent(parent)  # a killed parent takes its workers with it
     _progress_queue = queue
 
 
@@ -294,7 +296,7 @@ def run_tasks(
     ctx = _context()
     queue = ctx.Queue()
     workers = min(jobs, len(tasks))
-    pool = ctx.Pool(workers, initializer=_init_worker, initargs=(queue,))
+    pool = ctx.Pool(workers, initializer=_init_worker, initargs=(queue, os.getpid()))
     try:
         waiting = iter(range(len(tasks)))
         running: dict[int, Any] = {}

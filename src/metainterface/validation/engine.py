@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import multiprocessing as mp
+import os
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -23,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._process import die_with_parent
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.validation.bem import LoadPath, solve_path
@@ -67,7 +69,12 @@ def solve_task(task: BemTask) -> LoadPath:
 def local_pool(workers: int) -> cf.ProcessPoolExecutor:
     """A pool of ``workers`` local processes (fork on Linux: they start in milliseconds)."""
     ctx = mp.get_context("fork" if sys.platform.startswith("linux") else "spawn")
-    return cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    return cf.ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=ctx,
+        initializer=die_with_parent,  # a killed sweep takes its workers with it
+        initargs=(os.getpid(),),
+    )
 
 
 def stream(

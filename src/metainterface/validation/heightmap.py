@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from metainterface import _checks
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.curves import anchor
@@ -60,6 +61,11 @@ def default_grid(settings: CellSettings) -> int:
     return POINTS_PER_ASPERITY * settings.n_side
 
 
+#: Memory of one grid point in a BEM solve: heights, owner map, Tamaas's traction,
+#: displacement, gap and FFT buffers (a generous count, so that a refusal is never wrong).
+BYTES_PER_POINT = 160
+
+
 def check_grid(grid: int, settings: CellSettings) -> int:
     """Validate M: a whole number >= 2 n that n divides; returns it as int."""
     n = settings.n_side
@@ -67,8 +73,10 @@ def check_grid(grid: int, settings: CellSettings) -> int:
         raise MetainterfaceError(f"grid must be a whole number, got {grid!r}")
     if grid < 2 * n or grid % n:
         raise MetainterfaceError(
-            f"grid must be a multiple of the lattice side n = {n} and >= {2 * n}, got {grid}"
+            f"grid must be a multiple of the lattice side n = {n} and >= {2 * n}, got {grid}",
+            argument="grid",
         )
+    _checks.affordable("grid", grid, float(grid) ** 2 * BYTES_PER_POINT, what=" for the BEM")
     return int(grid)
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import json
+import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass
@@ -21,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface import _checks
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, ModelCurve, get_model, models_at
@@ -197,15 +199,19 @@ def resolve_loads(loads: int | Sequence[float] | np.ndarray, p_star_max: float) 
     """The load path: K = ``loads`` uniform pressures P*_max i / K (i = 1..K), or the given
     P* values sorted. Every load must lie in (0, P*_max], P*_max reached at Delta_max."""
     if isinstance(loads, int | np.integer) and not isinstance(loads, bool):
-        if loads <= 0:
-            raise MetainterfaceError(f"loads must be a whole number > 0, got {loads}")
-        return p_star_max * np.arange(1, int(loads) + 1) / int(loads)
+        k = _checks.whole("loads", loads, low=1, high=MAX_LOADS)
+        return p_star_max * np.arange(1, k + 1) / k
     try:
         values = np.sort(np.asarray(loads, dtype=np.float64).ravel())
     except (TypeError, ValueError):
         raise MetainterfaceError("loads must be a count K or a list of pressures P*") from None
     if values.size == 0 or not np.isfinite(values).all():
         raise MetainterfaceError("loads must be a non-empty list of finite pressures P*")
+    if values.size > MAX_LOADS:
+        raise MetainterfaceError(
+            f"loads: {values.size} pressures, more than {MAX_LOADS} (each is a BEM solve)",
+            argument="loads",
+        )
     if values[0] <= 0:
         raise MetainterfaceError(
             f"loads: P* = {values[0]:g} is not > 0; allowed range (0, {p_star_max:.6g}]"
@@ -225,13 +231,8 @@ def design_target(design: Design) -> tuple[np.ndarray, np.ndarray] | None:
         return None
     if not (isinstance(target, dict) and "p_star" in target and "alpha" in target):
         raise MetainterfaceError('target must be an object {"p_star": [...], "alpha": [...]}')
-    try:
-        p = np.asarray(target["p_star"], dtype=np.float64)
-        a = np.asarray(target["alpha"], dtype=np.float64)
-    except (TypeError, ValueError):
-        raise MetainterfaceError(
-            "target.p_star and target.alpha must be lists of numbers"
-        ) from None
+    p = _checks.vector("target.p_star", target["p_star"])
+    a = _checks.vector("target.alpha", target["alpha"])
     if p.ndim != 1 or p.shape != a.shape or p.size < 2:
         raise MetainterfaceError(
             "target.p_star and target.alpha must be lists of one length (>= 2 points)"
@@ -382,6 +383,13 @@ class ValidationPlan:
         )
 
 
+#: Most loads of one path: each is a full BEM solve (seconds to minutes on a fine grid).
+MAX_LOADS = 10_000
+#: Loosest tolerance of the contact solve accepted: above it a "converged" solve is not a
+#: solution (the paper's is 1e-11; 1e-9 gives the same areas).
+MAX_TOLERANCE = 1e-6
+
+
 def plan_validation(
     design: Design,
     grid: int | None = None,
@@ -398,8 +406,7 @@ def plan_validation(
     """
     if isinstance(max_iter, bool) or not (isinstance(max_iter, int | np.integer) and max_iter >= 1):
         raise MetainterfaceError(f"max_iter must be a whole number >= 1, got {max_iter!r}")
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise MetainterfaceError(f"tolerance must be a number > 0, got {tolerance!r}")
+    tolerance = _checks.number("tolerance", tolerance, low=0.0, low_open=True, high=MAX_TOLERANCE)
     grid = default_grid(design.settings) if grid is None else check_grid(grid, design.settings)
     design_target(design)  # a malformed target fails now, not after the solve
     model = get_model(model)
@@ -416,9 +423,9 @@ def plan_validation(
 
 
 def check_jobs(jobs: int) -> int:
-    if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs < 1:
-        raise MetainterfaceError(f"jobs must be a whole number >= 1, got {jobs!r}")
-    return int(jobs)
+    """Processes: at least 1, at most four per core (more only thrash, and a typo of
+    10000 would start 10000 processes)."""
+    return _checks.whole("jobs", jobs, low=1, high=4 * (os.cpu_count() or 1))
 
 
 # --- one design --------------------------------------------------------------------------
