@@ -40,8 +40,8 @@ def test_a_long_target_makes_a_small_design_file(tmp_path, capsys):
     args = ["design", "--target-csv", str(csv), "--out", str(out), "--refine", "none"]
     assert main([*args, "--full-target"]) == 0
     data = json.loads((out / "design.json").read_text())
-    assert (out / "design.json").stat().st_size < 120_000
-    assert data["target"]["points"] == 20_000 and len(data["target"]["p_star"]) <= 2048
+    assert (out / "design.json").stat().st_size < 80_000
+    assert data["target"]["points"] == 20_000 and len(data["target"]["p_star"]) <= 1024
     assert data["target"]["p_star"][-1] == pytest.approx(0.002)
     assert data["target"]["sha256"].startswith("sha256:")
     full = np.loadtxt(out / "target.csv", delimiter=",", skiprows=2)

@@ -82,14 +82,7 @@ def check_output_file(path: str | os.PathLike[str]) -> Path:
     path = Path(path)
     if "\0" in str(path):
         raise MetainterfaceError(f"output path {str(path)!r} contains a NUL character")
-    try:
-        mode = os.lstat(path).st_mode
-    except FileNotFoundError:
-        mode = None
-    except NotADirectoryError:
-        raise MetainterfaceError(f"cannot write {path}: {_file_ancestor(path)} is a file") from None
-    except OSError as exc:
-        raise MetainterfaceError(f"cannot write {path}: {exc.strerror}") from None
+    mode = _mode(path, follow=False)  # a symlink itself is not a regular file
     if mode is not None and not stat.S_ISREG(mode):
         raise MetainterfaceError(
             f"refusing to replace {path}: it is {_kind(mode)}, only regular files are replaced"
@@ -97,19 +90,24 @@ def check_output_file(path: str | os.PathLike[str]) -> Path:
     return path
 
 
+def _mode(path: Path, *, follow: bool) -> int | None:
+    """The file mode of ``path`` (None: nothing there); one-line errors for the rest."""
+    try:
+        return (os.stat if follow else os.lstat)(path).st_mode
+    except FileNotFoundError:
+        return None
+    except NotADirectoryError:
+        raise MetainterfaceError(f"cannot write {path}: {_file_ancestor(path)} is a file") from None
+    except OSError as exc:
+        raise MetainterfaceError(f"cannot write {path}: {exc.strerror}") from None
+
+
 def check_output_folder(path: str | os.PathLike[str]) -> Path:
     """``path`` is a usable output folder: not empty, a folder or nothing, no file above it."""
     if isinstance(path, str | os.PathLike) and not os.fspath(path):
         raise MetainterfaceError("output folder is empty; give a folder name")
     path = Path(path)
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        mode = None
-    except NotADirectoryError:
-        raise MetainterfaceError(f"cannot write {path}: {_file_ancestor(path)} is a file") from None
-    except OSError as exc:
-        raise MetainterfaceError(f"cannot write {path}: {exc.strerror}") from None
+    mode = _mode(path, follow=True)
     if mode is not None and not stat.S_ISDIR(mode):
         raise MetainterfaceError(f"output folder {path} is {_kind(mode)}, expected a folder")
     if mode is None:

@@ -25,10 +25,10 @@ if TYPE_CHECKING:
 #: Delta samples of a curve when none are asked for.
 CURVE_STEPS = 256
 #: Most points of a target curve stored in design.json (the full one goes to target.csv
-#: only when asked): small whatever the size of the user's file (~100 kB at most), yet
+#: only when asked): small whatever the size of the user's file (~60 kB at most), yet
 #: the built-in and typical measured targets are kept whole, so errors measured later to
 #: the stored target (tolerance, validate) equal the one the design reported.
-RECORD_POINTS = 2048
+RECORD_POINTS = 1024
 
 
 def _axes(ax: Axes | None) -> Axes:
