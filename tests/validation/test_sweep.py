@@ -139,6 +139,29 @@ def test_a_folder_of_design_runs_is_swept_by_their_folder_names(tmp_path, capsys
     assert "must be unique" in capsys.readouterr().err
 
 
+def test_a_sweep_after_multithreaded_torch_work_does_not_hang(tmp_path):
+    """Local workers are forked: one that ran torch after the parent had used torch's
+    OpenMP threads would hang in its first parallel operation (as the CI did, which runs
+    without OMP_NUM_THREADS=1). The workers get ready height maps and never run torch."""
+    script = f"""
+import numpy as np, torch
+import metainterface as mi
+torch.set_num_threads(2)
+x = torch.rand(1024, 1024, dtype=torch.float64)
+(x @ x).exp().sum()  # the parent's OpenMP threads are up
+cell = mi.CellSettings(n_asperities=1)
+designs = [mi.Design(gamma=np.array([g]), h=np.array([0.0]), settings=cell) for g in (2.0, 3.0)]
+mi.validate_many(designs, {str(tmp_path / "sweep")!r}, grid=16, loads=2, jobs=2, progress=False)
+print("swept")
+"""
+    env = {k: v for k, v in os.environ.items() if k != "OMP_NUM_THREADS"}
+    env["PYTHONPATH"] = SRC
+    done = subprocess.run(
+        [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=180
+    )
+    assert done.returncode == 0 and "swept" in done.stdout, done.stderr[-2000:]
+
+
 def _run_cli(args: list[str], **kw) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": SRC, "OMP_NUM_THREADS": "1"}
     return subprocess.Popen(

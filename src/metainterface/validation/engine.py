@@ -28,7 +28,7 @@ from metainterface._process import die_with_parent
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.validation.bem import LoadPath, solve_path
-from metainterface.validation.heightmap import height_map
+from metainterface.validation.heightmap import HeightMap, height_map
 
 #: Times a task the engine lost (a dead worker, a broken pool) is submitted again.
 RETRIES = 2
@@ -47,11 +47,16 @@ class BemTask:
     tolerance: float
     max_iter: int
     fields: bool = False
+    #: The design's height map, made by the process that plans the sweep: then a worker
+    #: runs numpy and Tamaas only, never torch (forked after the parent used torch's
+    #: OpenMP threads, a worker hangs in its first parallel torch operation).
+    heights: HeightMap | None = None
 
 
 def solve_task(task: BemTask) -> LoadPath:
-    """Run one task (in a worker): height map, then the warm-started load path."""
-    hm = height_map(task.design, task.grid)
+    """Run one task (in a worker): the warm-started load path on the task's height map
+    (made here if the task carries none)."""
+    hm = task.heights if task.heights is not None else height_map(task.design, task.grid)
     return solve_path(
         hm.heights,
         hm.cell_side,
