@@ -102,6 +102,36 @@ def test_errors_are_to_the_design_files_target_and_match_design(tmp_path):
     assert np.allclose(r.errors, r.error_nominal, rtol=1e-9)  # no error, every sample nominal
 
 
+def test_a_design_result_is_measured_to_its_own_target():
+    res = mi.design("saturating", method="multistart", starts=4)
+    r = mi.tolerance(res, sigma_h=0.0, samples=16)
+    assert r.reference is not None and r.reference.name == "saturating"
+    assert r.error_nominal == pytest.approx(res.error, rel=1e-3, abs=1e-7)
+    # its bare Design carries no target: the errors are to its own curve
+    assert mi.tolerance(res.design, sigma_h=0.0, samples=16).error_nominal < 1e-12
+    # an explicit target still wins
+    other = mi.tolerance(res, sigma_h=0.0, samples=16, target="linear")
+    assert other.reference.name == "linear" and other.error_nominal > 10 * res.error
+    s = mi.min_radius(res, printer_sigma="1um", max_error="20%", samples=64)
+    assert "target saturating" in s.settings["reference"]
+
+
+def test_nominal_error_of_a_design_that_stops_short_is_held_as_design_measures_it():
+    # one asperity reaches P*_max at Delta_max; a target running on to 1.5 P*_max is met
+    # exactly below it, and above it the design's curve stays at its last value
+    d = mi.Design(gamma=[2.7], h=[0.0], settings=mi.CellSettings(n_asperities=1))
+    side = d.settings.cell_side
+    p_max = float(mi.curve(d).p_star.max())
+    p = np.linspace(0.0, 1.5 * p_max, 2001)[1:]
+    exact = single_alpha(2.7, p, side)
+    held = single_alpha(2.7, np.minimum(p, p_max), side)
+    expect = np.linalg.norm(held - exact) / np.linalg.norm(exact)
+    target = mi.Target(p_star=p, alpha=exact, name="beyond")
+    r = mi.tolerance(d, sigma_h=0.0, samples=16, target=target)
+    assert expect > 0.02
+    assert r.error_nominal == pytest.approx(expect, rel=0.03)
+
+
 def test_units_need_a_radius_and_scale_by_it():
     d = mi.Design(gamma=[2.0, 3.0, 2.5, 3.5], h=[0.0, 0.004, 0.01, 0.013])
     a = mi.tolerance(d, sigma_h="1um", radius="0.5mm", samples=64)

@@ -22,6 +22,7 @@ import torch
 
 from metainterface import _checks
 from metainterface._files import provenance, strict_json, write_columns, write_text
+from metainterface.api.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import tolerance as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
@@ -260,6 +261,10 @@ def _pc(x: float) -> str:
 def _prepare(design, model, samples, seed, target, radius, option_names):
     from metainterface.api.functions import _as_design
 
+    if isinstance(design, DesignResult):  # a result knows its target: measure to it
+        if target is None:
+            target = design.target
+        design = design.design
     d = _as_design(design, None, None, None)
     samples = _checks.whole(option_names["samples"], samples, low=MIN_SAMPLES, high=MAX_SAMPLES)
     seed = _checks.whole(option_names["seed"], seed, low=0, high=2**63 - 1)
@@ -284,7 +289,7 @@ _NAMES = {
 
 
 def tolerance(
-    design: Design | str | os.PathLike[str],
+    design: Design | DesignResult | str | os.PathLike[str],
     *,
     sigma_h: float | str = 0.0,
     sigma_gamma: float = 0.0,
@@ -308,7 +313,9 @@ def tolerance(
 
     Parameters
     ----------
-    design : Design or path
+    design : Design, DesignResult or path
+        A result of :func:`~metainterface.design` is measured to its own target unless
+        ``target`` is given.
     sigma_h : float or str
         Standard deviation of each height offset. A plain number is in units of R (the
         paper's Delta_max is 0.02 R); a length with a unit ('1um') needs ``radius``.
@@ -326,8 +333,9 @@ def tolerance(
         Relative standard deviation of a common scale of all height offsets (a z-axis
         calibration error, shrinkage of the relief), in [0, 0.5].
     target : Target, str or None
-        What the error is measured to: None, the target the design file carries (else its
-        own nominal curve); ``"nominal"``, the nominal curve; or a Target / built-in name.
+        What the error is measured to: None, the target of a DesignResult or the one the
+        design file carries (else the design's own nominal curve); ``"nominal"``, the
+        nominal curve; or a Target / built-in name.
     shear_strength, modulus : str or float
         Interface shear strength tau and modulus E* ('0.25MPa', '2MPa'), for the
         friction-law band of the figure; default the design file's friction record.
@@ -456,7 +464,7 @@ class PrinterSizing:
 
 
 def min_radius(
-    design: Design | str | os.PathLike[str],
+    design: Design | DesignResult | str | os.PathLike[str],
     *,
     printer_sigma: str | float,
     max_error: float | str,
@@ -478,7 +486,9 @@ def min_radius(
 
     Parameters
     ----------
-    design : Design or path
+    design : Design, DesignResult or path
+        A result of :func:`~metainterface.design` is measured to its own target unless
+        ``target`` is given.
     printer_sigma : str or float
         The printer's height error, one standard deviation ('1um', or metres), > 0.
     max_error : float or str

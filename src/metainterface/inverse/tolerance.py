@@ -35,7 +35,7 @@ from torch import Tensor
 
 from metainterface.inverse.params import DTYPE
 from metainterface.inverse.perturb import Perturbation, loaded
-from metainterface.inverse.refine import TargetGrid
+from metainterface.inverse.refine import TargetGrid, relative_error
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import relative_l2
 from metainterface.physics.models import ForwardModel
@@ -117,7 +117,7 @@ def spread(
     h0 = torch.as_tensor(np.asarray(h), dtype=DTYPE)[None]
     grid = band_grid(g0, h0, settings, model, points)
     ref = reference_grid(g0, h0, settings, model, target, points)
-    settings = loaded(settings)
+    own_settings, settings = settings, loaded(settings)
     m = grid.shape[0]
     p_all = torch.cat([grid, ref.p[0]])[None]
     g_s, h_s = pert.apply(g0, h0)
@@ -131,12 +131,15 @@ def spread(
         )
     band, at_ref = alpha[:, :m], alpha[:, m:]
     errors = relative_l2(at_ref, ref.alpha)
+    # the nominal error as design reports it: on the design's own Delta range (held at its
+    # last value where it stops short), not loaded further like the made cells
+    nominal = relative_error(g0, h0, own_settings, ref, model)
     out = dict(
         p_star=grid.numpy(),
         alpha_nominal=band[0].numpy(),
         alpha=band[1:].numpy(),
         errors=errors[1:].numpy(),
-        error_nominal=float(errors[0]),
+        error_nominal=float(nominal[0]),
         gamma=g_s.numpy(),
         h=h_s.numpy(),
         clipped=pert.clipped(g0),
