@@ -2,8 +2,9 @@
 
 Build (from the repository root): ``sphinx-build -W --keep-going -b html docs docs/_build/html``.
 Warnings are errors; the tutorials are executed on every build; the API reference is
-generated from ``metainterface.__all__`` (``_ext/metainterface_docs.py``). Nothing is
-fetched from the network: no intersphinx, no remote assets.
+generated from ``metainterface.__all__`` (``_ext/metainterface_docs.py``). The build
+fetches nothing from the network (no intersphinx). The pages load MathJax from its CDN
+when they are viewed, as Sphinx does by default: opened offline, equations show as TeX.
 """
 
 from __future__ import annotations

@@ -320,3 +320,13 @@ def test_plot_methods_draw_on_given_axes(csv_result):
         ax = Figure(figsize=(width, 0.75 * width), layout="constrained").add_subplot()
         csv_result.curve().plot(ax)
         check_figure(ax.figure)
+
+
+def test_figures_returned_to_a_notebook_draw_as_png(csv_result):
+    """A notebook cell that returns result.figure() or tolerance(...).plot() shows the
+    picture: IPython asks the object for _repr_png_ (our figures are made without pyplot,
+    which IPython would otherwise show as a text repr)."""
+    png = b"\x89PNG\r\n\x1a\n"
+    assert csv_result.figure(width=SMALL)._repr_png_().startswith(png)
+    tol = mi.tolerance(csv_result, sigma_h=0.001, samples=32)
+    assert tol.plot()._repr_png_().startswith(png)

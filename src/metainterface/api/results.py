@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import io
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,6 +40,20 @@ def _axes(ax: Axes | None) -> Axes:
     import matplotlib.pyplot as plt
 
     return plt.subplots(figsize=(5.0, 3.6), layout="constrained")[1]
+
+
+def shown(fig: Figure) -> Figure:
+    """``fig``, drawn as a PNG when a notebook cell returns it. Our figures are made
+    without pyplot (no backend, safe in scripts and threads), and IPython shows such a
+    Figure only as its repr; IPython looks ``_repr_png_`` up on the object itself."""
+
+    def png() -> bytes:
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format="png", dpi=100)
+        return buffer.getvalue()
+
+    fig._repr_png_ = png  # type: ignore[attr-defined]
+    return fig
 
 
 @dataclass(frozen=True, repr=False)
@@ -260,7 +275,7 @@ class DesignResult:
         above. width: figure width in inches (default: the figure's own)."""
         from metainterface.plots import plot_design
 
-        return plot_design(self, self.figure_curve(), width=width)
+        return shown(plot_design(self, self.figure_curve(), width=width))
 
     def figure_curve(self) -> Curve:
         """The design's curve for figures: dense, with every engagement resolved."""

@@ -22,7 +22,7 @@ import torch
 
 from metainterface import _checks
 from metainterface._files import provenance, strict_json, write_columns, write_text
-from metainterface.api.results import DesignResult
+from metainterface.api.results import DesignResult, shown
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import tolerance as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
@@ -222,7 +222,7 @@ class ToleranceResult:
         strength and a modulus, the friction-law band."""
         from metainterface.plots.tolerance import plot_tolerance
 
-        return plot_tolerance(self)
+        return shown(plot_tolerance(self))
 
     def save(self, folder: str | os.PathLike[str], **extra: Any) -> Path:
         """Write band.csv, tolerance.json and tolerance.png into ``folder``; returns it.
