@@ -97,6 +97,24 @@ def test_cli_bad_manufacturing_options_exit_2(tmp_path, capsys, extra, fragment)
     assert fragment in err and "\n" not in err
 
 
+@pytest.mark.parametrize(
+    ("z_step", "fragment"),
+    [
+        ("30um", "--z-step must be in (0, Delta_max = 10 um], got 30 um"),
+        ("1MPa", "--z-step expects a length"),
+        ("0", "--z-step must be in (0, Delta_max"),
+    ],
+)
+def test_cli_export_bad_z_step_exit_2(tmp_path, capsys, z_step, fragment):
+    """export checks --z-step against the design's own Delta_max (10 um at R = 0.5 mm)."""
+    design = mi.Design(gamma=np.full(4, 2.5), h=np.zeros(4)).save(tmp_path / "d.json")
+    out = tmp_path / "p.stl"
+    args = ["export", str(design), "--radius", "0.5mm", "--z-step", z_step, "--out", str(out)]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert fragment in err and "\n" not in err and not out.exists()
+
+
 def test_cli_robust_and_z_step(tmp_path, capsys):
     argv = ["design", "--target", "saturating", "--method", "multistart", "--starts", "2"]
     argv += ["--robust", "--sigma-h", "1um", "--radius", "0.5mm", "--robust-samples", "4"]

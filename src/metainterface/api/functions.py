@@ -270,19 +270,13 @@ def _manufacturing(
     seed: int,
 ) -> tuple[Perturbation | None, float | None, float | None]:
     """The perturbation of a robust design and the layer step [units of R], checked."""
-    from metainterface.api.tolerance import length_in_r
+    from metainterface.api.tolerance import layer_step, length_in_r
 
     if not isinstance(robust, bool):
         raise MetainterfaceError(f"robust must be True or False, got {robust!r}")
     radius_m = None if radius is None else parse_length(radius, option="radius")
     cell = settings or CellSettings()
-    step = None
-    if z_step is not None:
-        step = length_in_r(z_step, radius_m, option="z_step", radius_option="radius")
-        if not 0 < step <= cell.delta_max:
-            raise MetainterfaceError(
-                f"z_step must be in (0, Delta_max = {cell.delta_max:g} R], got {step:g} R"
-            )
+    step = None if z_step is None else layer_step(z_step, radius_m, cell.delta_max)
     if not robust:
         if any(v not in (0, 0.0) for v in (sigma_h, sigma_gamma, scale_sigma)):
             raise MetainterfaceError("sigma_h, sigma_gamma and scale_sigma need robust=True")
@@ -564,13 +558,9 @@ def export(
     source = str(design) if isinstance(design, str | os.PathLike) else None
     step = None
     if z_step is not None:
-        from metainterface.api.tolerance import length_in_r
+        from metainterface.api.tolerance import layer_step
 
-        step = length_in_r(z_step, radius_m, option="z_step", radius_option="radius")
-        if not 0 < step <= d.settings.delta_max:
-            raise MetainterfaceError(
-                f"z_step must be in (0, Delta_max = {d.settings.delta_max:g} R], got {step:g} R"
-            )
+        step = layer_step(z_step, radius_m, d.settings.delta_max)
     notes = idle_notes(d)
     record = export_design(
         d,

@@ -59,6 +59,28 @@ def length_in_r(value: Any, radius_m: float | None, *, option: str, radius_optio
     return _checks.number(option, value, low=0.0)
 
 
+def layer_step(
+    value: Any,
+    radius_m: float | None,
+    delta_max: float,
+    *,
+    option: str = "z_step",
+    radius_option: str = "radius",
+) -> float:
+    """A printer's layer height in units of R, in (0, Delta_max] (read as in
+    :func:`length_in_r`); the range is stated in um when R is known."""
+    step = length_in_r(value, radius_m, option=option, radius_option=radius_option)
+    if not 0 < step <= delta_max:
+        if radius_m:
+            span, got = f"{delta_max * radius_m * 1e6:.4g} um", f"{step * radius_m * 1e6:.4g} um"
+        else:
+            span, got = f"{delta_max:g} R", f"{step:g} R"
+        raise MetainterfaceError(
+            f"{option} must be in (0, Delta_max = {span}], got {got}", argument=option
+        )
+    return step
+
+
 def _radius(radius: Any, design: Design, option: str) -> float | None:
     """R [m] from the argument, else from the design file's physical or friction record."""
     if radius is not None:

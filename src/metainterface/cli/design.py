@@ -241,20 +241,16 @@ def run(args: argparse.Namespace) -> int:
 def _manufacturing(args: argparse.Namespace) -> dict:
     """The robust-design and layer options, lengths in units of R (errors name the options)."""
     import metainterface as mi
-    from metainterface.api.tolerance import length_in_r
+    from metainterface.api.tolerance import layer_step, length_in_r
     from metainterface.physical import parse_length
 
     radius = None if args.radius is None else parse_length(args.radius, option="--radius")
     out: dict = {}
     if args.z_step is not None:
-        out["z_step"] = length_in_r(
-            args.z_step, radius, option="--z-step", radius_option="--radius"
+        delta_max = (_settings(args) or mi.CellSettings()).delta_max
+        out["z_step"] = layer_step(
+            args.z_step, radius, delta_max, option="--z-step", radius_option="--radius"
         )
-        delta_max = 0.02 if args.delta_max is None else args.delta_max
-        if not 0 < out["z_step"] <= delta_max:
-            raise mi.MetainterfaceError(
-                f"--z-step must be in (0, Delta_max = {delta_max:g} R], got {out['z_step']:g} R"
-            )
     given = args.sigma_h is not None or args.sigma_gamma or args.scale_sigma
     if not args.robust:
         if given:

@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
         format=args.format,
         resolution=resolution,
         base=parse_length(args.base, option="--base"),
-        z_step=_z_step(args),
+        z_step=args.z_step,  # checked against the design's Delta_max by export
     )
     for note in rec.get("notes", ()):
         print(f"warning: {note}", file=sys.stderr)
@@ -85,22 +85,3 @@ def run(args: argparse.Namespace) -> int:
         )
     print(f"{args.out}: {rec['format']} of {nx}x{ny} cells, {size}, {detail}")
     return 0
-
-
-def _z_step(args: argparse.Namespace) -> float | None:
-    """--z-step in units of R (errors name the option)."""
-    if args.z_step is None:
-        return None
-    import metainterface as mi
-    from metainterface.api.tolerance import length_in_r
-    from metainterface.physical import parse_length
-
-    radius = parse_length(args.radius, option="--radius")
-    step = length_in_r(args.z_step, radius, option="--z-step", radius_option="--radius")
-    delta_max = mi.Design.load(args.design).settings.delta_max
-    if not 0 < step <= delta_max:
-        raise mi.MetainterfaceError(
-            f"--z-step must be in (0, Delta_max = {delta_max * radius * 1e6:.4g} um], "
-            f"got {step * radius * 1e6:.4g} um"
-        )
-    return step

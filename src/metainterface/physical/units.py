@@ -97,7 +97,8 @@ def parse_quantity(
         else:
             raise MetainterfaceError(
                 f"{expect}; {text!r} has dimension {quantity.dimensionality}, "
-                f"not that of {article} {dimension}"
+                f"not that of {article} {dimension}",
+                argument=option,
             )
     if not math.isfinite(si):
         raise MetainterfaceError(f"{option} must be finite, got {value!r}", argument=option)
