@@ -259,18 +259,8 @@ def _manufacturing(args: argparse.Namespace) -> dict:
     sigma_h = 0.0
     if args.sigma_h is not None:
         sigma_h = length_in_r(args.sigma_h, radius, option="--sigma-h", radius_option="--radius")
-    checks = (
-        ("--sigma-gamma", args.sigma_gamma, 0.0, None),
-        ("--scale-sigma", args.scale_sigma, 0.0, 0.5),
-    )
-    for name, value, low, high in checks:
-        if not (value >= low and (high is None or value <= high) and value < float("inf")):
-            span = f"[{low:g}, {'inf' if high is None else f'{high:g}'}]"
-            raise mi.MetainterfaceError(f"{name} must be a finite number in {span}, got {value}")
-    if not (1 <= args.robust_samples <= 1024):
-        raise mi.MetainterfaceError(
-            f"--robust-samples must be a whole number in [1, 1024], got {args.robust_samples}"
-        )
+    # --sigma-gamma, --scale-sigma and --robust-samples are checked by mi.design, whose
+    # errors carry the argument and so are shown under these option names
     if sigma_h == args.sigma_gamma == args.scale_sigma == 0.0:
         raise mi.MetainterfaceError("--robust needs --sigma-h, --sigma-gamma or --scale-sigma > 0")
     out.update(
