@@ -140,9 +140,9 @@ def test_a_folder_of_design_runs_is_swept_by_their_folder_names(tmp_path, capsys
 
 
 def test_a_sweep_after_multithreaded_torch_work_does_not_hang(tmp_path):
-    """Local workers are forked: one that ran torch after the parent had used torch's
-    OpenMP threads would hang in its first parallel operation (as the CI did, which runs
-    without OMP_NUM_THREADS=1). The workers get ready height maps and never run torch."""
+    """Local workers are forked: one that ran torch on several threads after the parent had
+    used torch's OpenMP threads would hang in its first parallel operation (as the CI did,
+    which runs without OMP_NUM_THREADS=1). The workers run torch on one thread."""
     script = f"""
 import numpy as np, torch
 import metainterface as mi

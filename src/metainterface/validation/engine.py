@@ -28,7 +28,7 @@ from metainterface._process import die_with_parent
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.validation.bem import LoadPath, solve_path
-from metainterface.validation.heightmap import HeightMap, height_map
+from metainterface.validation.heightmap import height_map
 
 #: Times a task the engine lost (a dead worker, a broken pool) is submitted again.
 RETRIES = 2
@@ -47,16 +47,11 @@ class BemTask:
     tolerance: float
     max_iter: int
     fields: bool = False
-    #: The design's height map, made by the process that plans the sweep: then a worker
-    #: runs numpy and Tamaas only, never torch (forked after the parent used torch's
-    #: OpenMP threads, a worker hangs in its first parallel torch operation).
-    heights: HeightMap | None = None
 
 
 def solve_task(task: BemTask) -> LoadPath:
-    """Run one task (in a worker): the warm-started load path on the task's height map
-    (made here if the task carries none)."""
-    hm = task.heights if task.heights is not None else height_map(task.design, task.grid)
+    """Run one task (in a worker): height map, then the warm-started load path."""
+    hm = height_map(task.design, task.grid)
     return solve_path(
         hm.heights,
         hm.cell_side,
@@ -75,11 +70,18 @@ def local_pool(workers: int) -> cf.ProcessPoolExecutor:
     """A pool of ``workers`` local processes (fork on Linux: they start in milliseconds)."""
     ctx = mp.get_context("fork" if sys.platform.startswith("linux") else "spawn")
     return cf.ProcessPoolExecutor(
-        max_workers=workers,
-        mp_context=ctx,
-        initializer=die_with_parent,  # a killed sweep takes its workers with it
-        initargs=(os.getpid(),),
+        max_workers=workers, mp_context=ctx, initializer=_start_worker, initargs=(os.getpid(),)
     )
+
+
+def _start_worker(parent: int) -> None:
+    """A local worker dies with its parent (a killed sweep takes it along) and runs torch on
+    one thread: forked after the parent used torch's OpenMP threads, a worker that asks for
+    several hangs in its first parallel operation; one worker per core wants one anyway."""
+    import torch
+
+    die_with_parent(parent)
+    torch.set_num_threads(1)
 
 
 def stream(

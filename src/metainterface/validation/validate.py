@@ -296,7 +296,6 @@ class ValidationPlan:
         """The path as ``chunks`` contiguous warm-started tasks of about equal cost."""
         weights = self.load_weights(curve) if chunks > 1 else None
         parts = split_path(len(self.loads), chunks, weights)
-        heights = self.height_map()  # here, so that the workers never run torch
         return [
             BemTask(
                 design=self.design,
@@ -307,7 +306,6 @@ class ValidationPlan:
                 tolerance=self.tolerance,
                 max_iter=self.max_iter,
                 fields=fields,
-                heights=heights,
             )
             for c in parts
         ]
