@@ -140,9 +140,9 @@ def test_a_folder_of_design_runs_is_swept_by_their_folder_names(tmp_path, capsys
 
 
 def test_a_sweep_after_multithreaded_torch_work_does_not_hang(tmp_path):
-    """Local workers are forked: one that ran torch on several threads after the parent had
-    used torch's OpenMP threads would hang in its first parallel operation (as the CI did,
-    which runs without OMP_NUM_THREADS=1). The workers run torch on one thread."""
+    """Workers are forked (ours, and a user's ProcessPoolExecutor): one that ran torch on
+    several threads after the parent had used torch's OpenMP threads would hang in its first
+    torch operation (as the CI did, which runs without OMP_NUM_THREADS=1)."""
     script = f"""
 import numpy as np, torch
 import metainterface as mi
@@ -152,6 +152,10 @@ x = torch.rand(1024, 1024, dtype=torch.float64)
 cell = mi.CellSettings(n_asperities=1)
 designs = [mi.Design(gamma=np.array([g]), h=np.array([0.0]), settings=cell) for g in (2.0, 3.0)]
 mi.validate_many(designs, {str(tmp_path / "sweep")!r}, grid=16, loads=2, jobs=2, progress=False)
+from concurrent.futures import ProcessPoolExecutor
+with ProcessPoolExecutor(2) as ex:
+    mi.validate_many(designs, {str(tmp_path / "own")!r}, grid=16, loads=2, executor=ex,
+                     progress=False)
 print("swept")
 """
     env = {k: v for k, v in os.environ.items() if k != "OMP_NUM_THREADS"}

@@ -15,10 +15,11 @@ up to ``retries`` times, and replaces a broken local pool that it owns.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import multiprocessing as mp
 import os
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -49,9 +50,25 @@ class BemTask:
     fields: bool = False
 
 
+@contextlib.contextmanager
+def _one_torch_thread() -> Iterator[None]:
+    """torch on one thread for the block, then as it was. A worker forked (by our pool or a
+    user's) after its parent used torch's OpenMP threads hangs in its first torch operation
+    on several threads; the height map is the only torch a task runs."""
+    import torch
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(threads)
+
+
 def solve_task(task: BemTask) -> LoadPath:
     """Run one task (in a worker): height map, then the warm-started load path."""
-    hm = height_map(task.design, task.grid)
+    with _one_torch_thread():
+        hm = height_map(task.design, task.grid)
     return solve_path(
         hm.heights,
         hm.cell_side,
@@ -70,18 +87,11 @@ def local_pool(workers: int) -> cf.ProcessPoolExecutor:
     """A pool of ``workers`` local processes (fork on Linux: they start in milliseconds)."""
     ctx = mp.get_context("fork" if sys.platform.startswith("linux") else "spawn")
     return cf.ProcessPoolExecutor(
-        max_workers=workers, mp_context=ctx, initializer=_start_worker, initargs=(os.getpid(),)
+        max_workers=workers,
+        mp_context=ctx,
+        initializer=die_with_parent,  # a killed sweep takes its workers with it
+        initargs=(os.getpid(),),
     )
-
-
-def _start_worker(parent: int) -> None:
-    """A local worker dies with its parent (a killed sweep takes it along) and runs torch on
-    one thread: forked after the parent used torch's OpenMP threads, a worker that asks for
-    several hangs in its first parallel operation; one worker per core wants one anyway."""
-    import torch
-
-    die_with_parent(parent)
-    torch.set_num_threads(1)
 
 
 def stream(
