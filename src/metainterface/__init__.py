@@ -42,49 +42,124 @@ numpy arrays and lists go in, numpy comes out; the differentiable torch engine i
 with one line naming the argument and the allowed range.
 """
 
+import sys
+import types
 from importlib.metadata import PackageNotFoundError, version
-
-from metainterface.api import (
-    Curve,
-    DesignResult,
-    PrinterSizing,
-    ToleranceResult,
-    compare,
-    curve,
-    design,
-    evaluate_surrogate,
-    export,
-    generate_dataset,
-    min_radius,
-    physical,
-    pressure_check,
-    tolerance,
-    train_surrogate,
-    validate,
-    validate_many,
-    view,
-    write_result,
-)
-from metainterface.errors import MetainterfaceError
-from metainterface.inverse.targets import Target
-from metainterface.physics.cell import CellSettings, Design
-from metainterface.physics.models import (
-    MODELS,
-    ForwardModel,
-    Independent,
-    Interacting,
-    get_model,
-    register_model,
-)
-from metainterface.runtime import tune_allocator
-from metainterface.surrogate.train import TrainConfig
-from metainterface.validation.validate import ValidationResult
+from typing import TYPE_CHECKING, Any
 
 try:
     #: The installed package's version (PEP 440); "0+unknown" in an uninstalled source tree.
     __version__ = version("metainterface")
 except PackageNotFoundError:  # running from a source tree that was not installed
     __version__ = "0+unknown"
+
+#: Where each public name lives. ``import metainterface`` imports none of them (so the
+#: command line's ``--help`` answers without torch); a name's module is imported on first use
+#: (PEP 562), and ``dir(mi)``, ``help(mi)`` and the API reference still list every name.
+_HOMES: dict[str, str] = {
+    "Curve": "metainterface.api",
+    "DesignResult": "metainterface.api",
+    "PrinterSizing": "metainterface.api",
+    "ToleranceResult": "metainterface.api",
+    "compare": "metainterface.api",
+    "curve": "metainterface.api",
+    "design": "metainterface.api",
+    "evaluate_surrogate": "metainterface.api",
+    "export": "metainterface.api",
+    "generate_dataset": "metainterface.api",
+    "min_radius": "metainterface.api",
+    "physical": "metainterface.api",
+    "pressure_check": "metainterface.api",
+    "tolerance": "metainterface.api",
+    "train_surrogate": "metainterface.api",
+    "validate": "metainterface.api",
+    "validate_many": "metainterface.api",
+    "view": "metainterface.api",
+    "write_result": "metainterface.api",
+    "MetainterfaceError": "metainterface.errors",
+    "Target": "metainterface.inverse.targets",
+    "CellSettings": "metainterface.physics.cell",
+    "Design": "metainterface.physics.cell",
+    "MODELS": "metainterface.physics.models",
+    "ForwardModel": "metainterface.physics.models",
+    "Independent": "metainterface.physics.models",
+    "Interacting": "metainterface.physics.models",
+    "get_model": "metainterface.physics.models",
+    "register_model": "metainterface.physics.models",
+    "tune_allocator": "metainterface.runtime",
+    "TrainConfig": "metainterface.surrogate.train",
+    "ValidationResult": "metainterface.validation.validate",
+}
+
+if TYPE_CHECKING:  # what type checkers and IDEs see
+    from metainterface.api import (
+        Curve,
+        DesignResult,
+        PrinterSizing,
+        ToleranceResult,
+        compare,
+        curve,
+        design,
+        evaluate_surrogate,
+        export,
+        generate_dataset,
+        min_radius,
+        physical,
+        pressure_check,
+        tolerance,
+        train_surrogate,
+        validate,
+        validate_many,
+        view,
+        write_result,
+    )
+    from metainterface.errors import MetainterfaceError
+    from metainterface.inverse.targets import Target
+    from metainterface.physics.cell import CellSettings, Design
+    from metainterface.physics.models import (
+        MODELS,
+        ForwardModel,
+        Independent,
+        Interacting,
+        get_model,
+        register_model,
+    )
+    from metainterface.runtime import tune_allocator
+    from metainterface.surrogate.train import TrainConfig
+    from metainterface.validation.validate import ValidationResult
+
+
+def __getattr__(name: str) -> Any:
+    home = _HOMES.get(name)
+    if home is None:
+        raise AttributeError(f"module 'metainterface' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(home), name)
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Face(types.ModuleType):
+    """This package's module type: a public name is never replaced by a subpackage.
+
+    The import system sets a subpackage as an attribute of its parent when it first loads it;
+    ``physical`` is both a subpackage and a public function, and with lazy names that load
+    may come after the function was looked up. The function stays.
+    """
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in _HOMES and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Face
+
 
 __all__ = [
     "MODELS",

@@ -16,8 +16,6 @@ import platform
 from datetime import UTC, datetime
 from typing import Any
 
-import torch
-
 from metainterface._files import strict_json
 
 #: Longest JSON text of one setting kept as is; longer ones are replaced by their hash.
@@ -37,6 +35,13 @@ def _compact(value: Any) -> Any:
     return value if len(text) <= MAX_INLINE else short_hash(value)
 
 
+def _torch_version() -> str:
+    # imported here: the CLI's entry point imports this module before any work starts
+    import torch
+
+    return str(torch.__version__)
+
+
 def provenance(*, stamp: bool = True, **settings: Any) -> dict[str, Any]:
     """A JSON-ready record: package, version, time, python, torch, the hash of all
     ``settings`` and the settings themselves.
@@ -50,7 +55,7 @@ def provenance(*, stamp: bool = True, **settings: Any) -> dict[str, Any]:
         "version": __version__,
         "created": datetime.now(UTC).isoformat(timespec="seconds"),
         "python": platform.python_version(),
-        "torch": str(torch.__version__),
+        "torch": _torch_version(),
         "inputs_sha256": short_hash(settings),
         "settings": settings,
     }

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
 from metainterface.cli.common import positive_float, positive_int
-from metainterface.physics.models import DEFAULT_MODEL, MODELS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -25,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--physics",
-        choices=tuple(MODELS),
+        choices=MODEL_NAMES,
         default=DEFAULT_MODEL,
         help="forward model: the paper's independent asperities (default) or with their "
         "elastic interaction through the periodic lattice",

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from metainterface._names import DEFAULT_MODEL, METHOD_NAMES, MODEL_NAMES
 from metainterface.cli.common import positive_int
-from metainterface.inverse.pipeline import METHODS
-from metainterface.physics.models import DEFAULT_MODEL, MODELS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -55,7 +54,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="also write view.html, an interactive page of each design (needs the [view] extra)",
     )
-    p.add_argument("--method", choices=METHODS, default="surrogate")
+    p.add_argument("--method", choices=METHOD_NAMES, default="surrogate")
     p.add_argument("--refine", choices=("lbfgs", "none"), default="lbfgs")
     p.add_argument(
         "--compare",
@@ -83,7 +82,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--physics",
-        choices=tuple(MODELS),
+        choices=MODEL_NAMES,
         default=DEFAULT_MODEL,
         help="forward model to refine and measure with (default: the paper's independent one)",
     )

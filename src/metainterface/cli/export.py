@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from metainterface.io.export import FORMATS
+from metainterface._names import EXPORT_FORMATS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -21,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tiles", default="1x1", help="cells along x and y, e.g. 4x4 (default 1x1)")
     p.add_argument(
         "--format",
-        choices=FORMATS,
+        choices=EXPORT_FORMATS,
         help="output format (default: from the --out suffix)",
     )
     p.add_argument("--out", required=True, help="output file; a sidecar OUT.json is written too")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from metainterface.physics.models import DEFAULT_MODEL, MODELS
+from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
 
 #: How the library's errors name the options: as typed on the command line.
 OPTION_NAMES = {
@@ -59,7 +59,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
     p.add_argument(
         "--model",
-        choices=tuple(MODELS),
+        choices=MODEL_NAMES,
         default=DEFAULT_MODEL,
         help="forward model (default: the paper's independent asperities)",
     )

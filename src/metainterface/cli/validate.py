@@ -10,8 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
 from metainterface.cli.common import positive_float, positive_int
-from metainterface.physics.models import DEFAULT_MODEL, MODELS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -100,7 +100,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--physics",
-        choices=tuple(MODELS),
+        choices=MODEL_NAMES,
         default=DEFAULT_MODEL,
         help="forward model that sets the loads and alpha_model: the paper's independent "
         "asperities (default) or with their elastic interaction; both are reported",

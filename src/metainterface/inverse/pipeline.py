@@ -21,6 +21,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from metainterface._names import METHOD_NAMES
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.params import (
     DTYPE,
@@ -49,7 +50,7 @@ if TYPE_CHECKING:  # the surrogate (and its imports) load only when a design nee
 
 #: Design methods and the parameterisation each refines: the surrogate's prediction and the
 #: multistart in the full space, the Hertz-only baseline with gamma fixed at 2.
-METHODS: dict[str, Parameterisation] = {"surrogate": FULL, "multistart": FULL, "hertz": HERTZ}
+METHODS: dict[str, Parameterisation] = dict(zip(METHOD_NAMES, (FULL, FULL, HERTZ), strict=True))
 
 
 @dataclass(frozen=True)

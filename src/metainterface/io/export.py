@@ -33,10 +33,11 @@ import numpy as np
 from metainterface._files import strict_json
 from metainterface._files.atomic import write_bytes, write_text
 from metainterface._files.provenance import provenance
+from metainterface._names import EXPORT_FORMATS
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 
-FORMATS = ("stl", "png", "tiff", "npy")
+FORMATS = EXPORT_FORMATS
 SUFFIXES = {".stl": "stl", ".png": "png", ".tif": "tiff", ".tiff": "tiff", ".npy": "npy"}
 #: Default grid: points per asperity pitch (4 a_max), so M = 64 n per cell side.
 POINTS_PER_PITCH = 64

@@ -21,6 +21,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from metainterface._names import DEFAULT_MODEL
 from metainterface.errors import MetainterfaceError
 from metainterface.physics import curves
 from metainterface.physics.cell import CellSettings, Design
@@ -280,9 +281,7 @@ class Interacting(ForwardModel):
 
 
 #: The registry: name -> model. ``design``, ``curve``, ``validate`` and the CLI read it.
-MODELS: dict[str, ForwardModel] = {"independent": Independent(), "interacting": Interacting()}
-#: The model used where none is named.
-DEFAULT_MODEL = "independent"
+MODELS: dict[str, ForwardModel] = {m.name: m for m in (Independent(), Interacting())}
 
 
 def register_model(model: ForwardModel) -> ForwardModel:
