@@ -117,6 +117,10 @@ def solve_batch(
     g_old = torch.ones(b, 1, 1, dtype=torch.float64, device=dev)
     conjugate = torch.zeros(b, 1, 1, dtype=torch.bool, device=dev)
     it = 0
+    # From a uniform pressure the first gap is -z, constant on any flat part of the surface:
+    # the error (new pressure, that gap) can read 0 there after one step (a flat punch does;
+    # so does Tamaas). A cold start takes at least two iterations.
+    min_iter = 2 if pressure is None else 1
     # Every field operation below is one pass over memory: float 0/1 masks (sign of p >= 0)
     # and batched dot products instead of torch.where and masked sums, which cost 2-10x more.
     while True:
@@ -151,7 +155,7 @@ def solve_batch(
             raise ArithmeticError(
                 f"the solve of item {int(rows[bad])} produced NaN (a contact of one grid point?)"
             )
-        done = (err <= tolerance) | (it >= max_iter)
+        done = ((err <= tolerance) & (it >= min_iter)) | (it >= max_iter)
         if bool(done.any()):
             idx = rows[done]
             out_p[idx] = p[done]
@@ -195,9 +199,24 @@ def solve_path(
         start = time.perf_counter()
         target = torch.tensor([load], dtype=torch.float64, device=device)
         try:
-            p, gap, err, _ = solve_batch(
-                z, kernel, target, p, tolerance=tolerance, max_iter=max_iter, check_every=every
-            )
+            try:
+                p, gap, err, _ = solve_batch(
+                    z, kernel, target, p, tolerance=tolerance, max_iter=max_iter, check_every=every
+                )
+            except ArithmeticError:
+                if p is None:
+                    raise
+                # a previous contact of a grid point or two leaves the conjugate gradient no
+                # direction (0 / 0): start this load afresh from a uniform pressure
+                p, gap, err, _ = solve_batch(
+                    z,
+                    kernel,
+                    target,
+                    None,
+                    tolerance=tolerance,
+                    max_iter=max_iter,
+                    check_every=every,
+                )
         except ArithmeticError as exc:
             raise ArithmeticError(i, str(exc)) from None
         pressure, gap_np = p[0].cpu().numpy(), gap[0].cpu().numpy()
