@@ -3,8 +3,8 @@ Tamaas on the same height maps, the batch solver, and the engine / device option
 
 import math
 import sys
-from types import SimpleNamespace
 from importlib.resources import files
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
