@@ -24,3 +24,14 @@ def positive_float(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
     return value
+
+
+def add_device(parser: argparse.ArgumentParser) -> None:
+    """``--device``: where the command's torch work runs, checked by the library
+    (``metainterface._device.resolve_device``) so the values and errors match the API's."""
+    parser.add_argument(
+        "--device",
+        default="auto",
+        metavar="DEVICE",
+        help="auto, cpu, cuda or cuda:N (default auto: CUDA when torch sees it, else the CPU)",
+    )
