@@ -268,22 +268,20 @@ def _affordable_rows(
     missed, in a batch of its own after the first is freed (so the larger of the two, not
     their sum)."""
     per_target = starts if method != "surrogate" else max(1 + hedge, fallback)
-    what = ""
-    if device.type == "cuda":
-        import torch
-
-        total = torch.cuda.get_device_properties(device).total_memory
-        if per_target * targets * n * BYTES_PER_START > _checks.MEMORY_SHARE * total:
-            raise MetainterfaceError(
-                f"starts = {starts} for {targets} target(s) would need about "
-                f"{per_target * targets * n * BYTES_PER_START / 2**30:.1f} GiB on {device}, more "
-                f"than half its {total / 2**30:.1f} GiB; design fewer targets per call",
-                argument="starts",
-            )
+    nbytes = per_target * targets * n * BYTES_PER_START
+    what = f" for {targets} targets" if targets > 1 else ""
+    if device.type != "cuda":
+        _checks.affordable("starts", starts, nbytes, what=what)
         return
-    if targets > 1:
-        what = f" for {targets} targets"
-    _checks.affordable("starts", starts, per_target * targets * n * BYTES_PER_START, what=what)
+    import torch
+
+    total = torch.cuda.get_device_properties(device).total_memory
+    if nbytes > _checks.MEMORY_SHARE * total:
+        raise MetainterfaceError(
+            f"starts = {starts} would need about {nbytes / 2**30:.1f} GiB on {device}{what}, "
+            f"more than half its {total / 2**30:.1f} GiB; design fewer targets per call",
+            argument="starts",
+        )
 
 
 #: Made cells drawn to report a robust design's error distribution (independent of the

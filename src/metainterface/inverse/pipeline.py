@@ -286,6 +286,9 @@ def printable(
     g_best = torch.where(better[:, None], g_new, gamma)
     err = torch.where(better, after, snapped)
     rob = torch.where(better, score_new, score_old) if perturb is not None else None
+    # one copy to the host for all targets (it waits for the device)
+    g_best, h, err, snapped = g_best.cpu(), h.cpu(), err.cpu(), snapped.cpu()
+    rob = None if rob is None else rob.cpu()
     extra = (time.perf_counter() - t0) / len(results)
     out = []
     for i, r in enumerate(results):
