@@ -55,8 +55,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--batch-size",
         type=positive_int,
         default=DEFAULTS["batch_size"],
-        help="goes with --lr: 1024 with 2e-3 (the shipped model's); a GPU wants larger "
-        "batches and then a larger --lr",
+        help="goes with --lr: 1024 with 2e-3 by default (the shipped model: 512 with "
+        "2e-3); a GPU wants larger batches, and then a larger --lr",
     )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(

@@ -53,10 +53,10 @@ class TrainConfig:
     epochs, batch_size, lr, weight_decay, patience, seed
         AdamW with a cosine learning rate peaking at ``lr``; early stopping after
         ``patience`` epochs without a better validation loss; ``seed`` fixes every draw.
-        ``batch_size`` and ``lr`` go together: 1024 with 2e-3 is the pair the shipped model
-        was trained with. A GPU is busy only with larger batches (8192); fewer steps per
-        epoch then need a larger ``lr`` (docs/concepts/devices.md), so change both or
-        neither.
+        ``batch_size`` and ``lr`` go together: 1024 with 2e-3 by default (the shipped model
+        was trained with 512 and 2e-3). A GPU is busy only with larger batches (8192);
+        fewer steps per epoch then need a larger ``lr`` (docs/concepts/devices.md), so
+        change both or neither.
     curriculum_epochs, lambda_start
         The supervised anchor lambda falls linearly from ``lambda_start`` to 0 over
         ``curriculum_epochs``.
