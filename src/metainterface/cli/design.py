@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from metainterface._names import DEFAULT_MODEL, METHOD_NAMES, MODEL_NAMES
-from metainterface.cli.common import positive_int
+from metainterface.cli.common import add_device, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -123,6 +123,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--max-pressure",
         help="peak contact pressure limit: p/E* (number) or a stress with --modulus",
     )
+    add_device(p)
     p.set_defaults(func=run)
 
 
@@ -180,6 +181,7 @@ def run(args: argparse.Namespace) -> int:
         settings=_settings(args),
         meta=_command(args),
         full_target=args.full_target,
+        device=args.device,
         **_manufacturing(args),
     )
     if args.compare:
