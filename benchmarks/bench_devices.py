@@ -161,7 +161,10 @@ def main() -> None:
         machines = "\n".join(f"- {d}: {w}" for d, w in where.items())
         Path(args.out).write_text(
             f"# Devices (issue 29)\n\n`{cmd}`; torch {torch.__version__}.\n\n"
-            f"Columns:\n\n{machines}\n\n{table}\n"
+            f"Columns:\n\n{machines}\n\n{table}\n\n"
+            "One run of each step after a warm-up; OMP_NUM_THREADS as set by the caller. On a "
+            "machine shared with other jobs the times are noisy: compare rows as ratios "
+            "within one column, not across runs.\n"
         )
 
 

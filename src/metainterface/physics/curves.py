@@ -93,10 +93,14 @@ def _contact_floor(dtype: torch.dtype) -> float:
 
 
 def delta_grid(
-    settings: CellSettings, n_delta: int | None = None, *, dtype=torch.float64
+    settings: CellSettings, n_delta: int | None = None, *, dtype=torch.float64, device=None
 ) -> Tensor:
-    """(K,) uniform global indentations on [0, Delta_max]; K defaults to settings.n_steps."""
-    return torch.linspace(0.0, settings.delta_max, n_delta or settings.n_steps, dtype=dtype)
+    """(K,) uniform global indentations on [0, Delta_max]; K defaults to settings.n_steps.
+
+    Made on ``device`` (default the CPU): a grid copied there from the host at every call
+    would make the GPU wait for it (a training step sweeps once)."""
+    n = n_delta or settings.n_steps
+    return torch.linspace(0.0, settings.delta_max, n, dtype=dtype, device=device)
 
 
 def anchor(h: Tensor) -> Tensor:
@@ -124,7 +128,7 @@ def sweep(
     """
     dtype = gamma.dtype
     if delta is None:
-        delta = delta_grid(settings, n_delta, dtype=dtype).to(gamma.device)
+        delta = delta_grid(settings, n_delta, dtype=dtype, device=gamma.device)
     p_star, alpha, stiffness, load_slope = _SweepFunction.apply(
         gamma, anchor(h), delta, smooth, settings.radius, settings.nominal_area
     )
@@ -424,7 +428,7 @@ def solve_delta(
             newton_fn = _independent_load(gamma, h, settings)
         else:
             newton_fn = functools.partial(fn, gamma, h, settings)
-        grid = delta_grid(settings, n_delta, dtype=gamma.dtype).to(gamma.device)
+        grid = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
         coarse = newton_fn(delta=grid.expand(gamma.shape[0], -1))
         knots = coarse.delta
         p_max = coarse.p_star[:, -1]

@@ -308,7 +308,7 @@ def _solve(
 ) -> tuple[Sweep, Tensor | None]:
     dtype, dev = gamma.dtype, gamma.device
     if delta is None:
-        delta = delta_grid(settings, n_delta, dtype=dtype).to(dev)
+        delta = delta_grid(settings, n_delta, dtype=dtype, device=dev)
     if kernel is None:
         kernel = interaction(settings, dtype=dtype, device=dev, curvature=curvature)
     both, off_and_c, k_diag = kernel.stacked(dtype, dev)

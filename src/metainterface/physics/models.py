@@ -230,7 +230,7 @@ class Independent(ForwardModel):
 
     def asperity_sweep(self, gamma, h, settings, *, n_delta=None, delta=None):
         if delta is None:
-            delta = delta_grid(settings, n_delta, dtype=gamma.dtype).to(gamma.device)
+            delta = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
         sw = curves.sweep(gamma, h, settings, delta=delta)
         gap = delta[None, :, None] - anchor(h)[:, None, :]
         return sw, area(gamma[:, None, :], gap, settings.radius) / settings.nominal_area
