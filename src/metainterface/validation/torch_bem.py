@@ -231,12 +231,14 @@ def solve_paths(
     device: torch.device,
     tolerance: float,
     max_iter: int,
+    on_load: Callable[[int, np.ndarray, np.ndarray, np.ndarray, float], Any],
     check_every: int | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> None:
     """B cells of one grid size along their load paths, solved as one batch per load.
 
-    heights: (B, M, M); cell_sides: (B,); loads: (B, K), ascending along K. Returns
-    (pressures (B, K, M, M), gaps (B, K, M, M), errors (B, K)).
+    heights: (B, M, M); cell_sides: (B,); loads: (B, K), ascending along K. on_load(k,
+    pressures (B, M, M), gaps (B, M, M), errors (B,), seconds) after each load k (numpy).
+    Raises ArithmeticError(k, why) on NaN at load k.
     """
     z = torch.as_tensor(np.ascontiguousarray(heights, dtype=np.float64), device=device)
     b, m, _ = z.shape
@@ -244,19 +246,29 @@ def solve_paths(
     kernel = unit_kernel(m, device)[None] * sides.reshape(b, 1, 1)
     loads = np.asarray(loads, dtype=np.float64)
     every = (1 if device.type == "cpu" else 4) if check_every is None else check_every
-    pressures = np.empty((b, loads.shape[1], m, m))
-    gaps = np.empty_like(pressures)
-    errors = np.empty((b, loads.shape[1]))
     p = None
     for k in range(loads.shape[1]):
+        start = time.perf_counter()
         target = torch.as_tensor(loads[:, k], device=device)
-        p, gap, err, _ = solve_batch(
-            z, kernel, target, p, tolerance=tolerance, max_iter=max_iter, check_every=every
+        try:
+            p, gap, err, _ = solve_batch(
+                z, kernel, target, p, tolerance=tolerance, max_iter=max_iter, check_every=every
+            )
+        except ArithmeticError as exc:
+            raise ArithmeticError(k, str(exc)) from None
+        on_load(
+            k, p.cpu().numpy(), gap.cpu().numpy(), err.cpu().numpy(), time.perf_counter() - start
         )
-        pressures[:, k] = p.cpu().numpy()
-        gaps[:, k] = gap.cpu().numpy()
-        errors[:, k] = err.cpu().numpy()
-    return pressures, gaps, errors
+
+
+def batch_size(grid: int, device: torch.device) -> int:
+    """Designs solved together on ``device``: 1 on the CPU (a batch is no faster there);
+    on a GPU as many as about a quarter of its free memory holds (some 30 M x M float64
+    fields per design), at most 32."""
+    if device.type != "cuda":
+        return 1
+    free, _ = torch.cuda.mem_get_info(device)
+    return int(max(1, min(32, free // 4 // (30 * 8 * grid * grid))))
 
 
 def check_converged(
