@@ -7,11 +7,11 @@ displacement of a periodic half-space under pressure p is diagonal in Fourier sp
 
     u_hat(q) = 2 p_hat(q) / (E* |q|),   |q| = 2 pi |k| / L,   u_hat(0) = 0,
 
-applied with real FFTs (``torch.fft.rfft2``; the kernel is built once per grid size and
-device). The contact problem (p >= 0, gap g = u - z - c >= 0, p g = 0, mean p = P*) is
-solved by the constrained conjugate gradient of Polonsky & Keer (Wear 231, 1999, 206-219)
-with the mean-pressure constraint of Rey, Anciaux & Molinari (Comput. Mech. 60, 2017,
-69-81): a conjugate gradient on the gap restricted to the points in contact, a projection
+applied with real-input FFTs (half the spectrum; ``displacement``), the kernel built once
+per grid size and device. The contact problem (p >= 0, gap g = u - z - c >= 0, p g = 0,
+mean p = P*) is solved by the constrained conjugate gradient of Polonsky & Keer (Wear 231,
+1999, 206-219) with the mean-pressure constraint of Rey, Anciaux & Molinari (Comput. Mech.
+60, 2017, 69-81): a conjugate gradient on the gap restricted to the points in contact, a projection
 onto p >= 0 that puts pressure back where the surface overlaps, and a rescaling to the
 prescribed mean pressure after each step.
 
@@ -22,7 +22,11 @@ both engines: the complementarity error
 
 sigma_z the standard deviation of the surface, g the (centred) gap of the iteration.
 A load path of ascending pressures starts each solve from the previous pressure field
-rescaled to the new mean (uniform pressure for the first load), as Tamaas does.
+rescaled to the new mean (uniform pressure for the first load), as Tamaas does. Two
+departures from Tamaas, both where it fails: a cold start takes at least two iterations
+(after one, that error reads 0 on a flat punch with the pressure still uniform), and a load
+whose warm start is a contact of one grid point (no conjugate direction: 0 / 0) starts
+again from a uniform pressure instead of failing.
 
 float64 throughout: float32 does not reach the paper's 1e-11. Several height maps of one
 grid size are solved as one batch (``solve_batch``), each item frozen as soon as it
