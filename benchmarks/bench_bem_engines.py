@@ -6,10 +6,12 @@ on a CUDA device when torch sees one (else that column says "unmeasured"). Every
 solves the same height map; the table gives the wall time of the path, the speed-up over
 Tamaas and the largest |alpha_torch / alpha_tamaas - 1| over the loads.
 
-Run with OMP_NUM_THREADS=1 (Tamaas on one thread; torch's threads are set here):
+Run with OMP_NUM_THREADS=1 (Tamaas on one thread; torch's threads are set here), and on a
+machine shared with other busy processes OMP_WAIT_POLICY=PASSIVE (else torch's threads spin
+waiting for a descheduled one):
 
-    OMP_NUM_THREADS=1 python benchmarks/bench_bem_engines.py [--grids 384 768] [--loads 20]
-        [--threads 1 2] [--profile] [--quick]
+    OMP_NUM_THREADS=1 OMP_WAIT_POLICY=PASSIVE python benchmarks/bench_bem_engines.py
+        [--grids 384 768] [--loads 20] [--threads 1 2] [--profile] [--quick]
 
 Writes benchmarks/results/bem_engines.md (not with --quick). Timings depend on what else
 runs on the cores: the load average is printed and recorded with them.
@@ -32,6 +34,8 @@ from metainterface.validation import solve_path, torch_threads
 from metainterface.validation.heightmap import height_map
 
 RESULTS = Path(__file__).parent / "results" / "bem_engines.md"
+#: Environment variables recorded with the command (they change what the threads do).
+ENV = ("OMP_NUM_THREADS", "OMP_WAIT_POLICY")
 EXAMPLE = files("metainterface") / "examples" / "example_design.json"
 
 
@@ -133,7 +137,8 @@ def main() -> None:
         f"Command ({datetime.date.today()}, {os.cpu_count()} cores, torch {torch.__version__}):",
         "",
         "```bash",
-        "OMP_NUM_THREADS=1 python benchmarks/bench_bem_engines.py "
+        " ".join(f"{v}={os.environ[v]}" for v in ENV if v in os.environ)
+        + " python benchmarks/bench_bem_engines.py "
         f"--grids {' '.join(map(str, args.grids))} --loads {args.loads} "
         f"--threads {' '.join(map(str, args.threads))}",
         "```",
