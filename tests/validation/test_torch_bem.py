@@ -296,3 +296,12 @@ def test_a_sweep_solves_designs_as_one_batch(tmp_path, monkeypatch):
         assert again[name]["max_rel_err"] == pytest.approx(s["max_rel_err"], rel=1e-6, abs=1e-9)
     with pytest.raises(MetainterfaceError, match="batch > 1 needs engine='torch'"):
         mi.validate_many(designs, tmp_path / "x", batch=2, chunks=2, **kw)
+
+
+def test_a_failed_solve_is_one_line_naming_the_load(monkeypatch):
+    def nan(*args, **kwargs):
+        raise ArithmeticError("the solve of item 0 produced NaN")
+
+    monkeypatch.setattr(tb, "solve_batch", nan)
+    with pytest.raises(MetainterfaceError, match=r"BEM failed at load 1 of 2 \(P\* = .*finer grid"):
+        validate_design(HERTZ, 32, 2)
