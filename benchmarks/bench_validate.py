@@ -1,4 +1,4 @@
-"""BEM validation (Tamaas) wall time: the load path of one design.
+"""BEM validation wall time (the default engine, torch): the load path of one design.
 
 Targets (issue 6), on the 2-core machine:
   768 x 768, 20 loads, one 9-asperity design (the packaged example): <= 60 s wall

@@ -12,7 +12,7 @@ Start here::
                                              # mi.Target.from_csv, mi.Target.from_friction
     r = mi.design(t)                         # DesignResult: .design, .error, .plot()
     c = mi.curve(r.design, model="interacting")   # Curve: numpy p_star, alpha, stiffness
-    v = mi.validate(r.design, grid=96, loads=4)   # BEM check (Tamaas, the [bem] extra)
+    v = mi.validate(r.design, grid=96, loads=4)   # BEM check (torch; engine="tamaas": [bem])
     mi.export(r.design, "patch.stl", radius="0.5mm", tiles=(2, 2))
 
 Targets and designs

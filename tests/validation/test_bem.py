@@ -79,8 +79,11 @@ def test_quick_three_by_three_cell():
 def test_no_convergence_names_the_load_and_residual():
     with pytest.raises(MetainterfaceError, match=r"load 1 of 2 \(P\* = .*residual .* > tol"):
         validate_design(HERTZ, 64, 2, max_iter=2)
-    # Tamaas's own failure (a one-node contact on a far too coarse grid): same kind of error
+    # Tamaas's own failure (a one-node contact on a far too coarse grid): same kind of error.
+    # The torch engine starts such a load afresh and goes on.
     four = Design(gamma=np.full(4, 2.0), h=np.zeros(4))
+    assert (validate_design(four, 8, 20).residual <= 1e-11).all()
+    pytest.importorskip("tamaas")
     with pytest.raises(MetainterfaceError, match=r"BEM failed at load \d+ of 20 .*finer grid"):
         validate_design(four, 8, 20, engine="tamaas")
 

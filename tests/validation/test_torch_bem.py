@@ -187,21 +187,30 @@ def test_batch_solves_as_one_item_at_a_time():
     sides = np.array([a.cell_side, b.cell_side])
     tops = [get_model().model_curve(d).p_star_max for d in (EXAMPLE, _random_design(2))]
     loads = np.array([[0.3 * tops[0], tops[0]], [0.5 * tops[1], 0.9 * tops[1]]])
-    p, gaps, err = tb.solve_paths(
-        np.stack([a.heights, b.heights]),
+    got = {}
+
+    def keep(k, pressures, gaps, errors, seconds):
+        got[k] = (pressures, gaps, errors)
+
+    heights = np.stack([a.heights, b.heights])
+    tb.solve_paths(
+        heights,
         sides,
         loads,
         device=CPU,
         tolerance=1e-11,
         max_iter=1000,
+        on_load=keep,
         check_every=4,
     )
-    assert (err <= 1e-11).all()
+    assert sorted(got) == [0, 1]
     for i, hm in enumerate((a, b)):
         alone = _solve(hm.heights, hm.cell_side, loads[i], "torch", n=9, owner=hm.owner)
-        scale = alone.pressures.max()
-        assert np.abs(p[i] - alone.pressures).max() < 1e-7 * scale
-        assert gaps[i].min() == 0.0
+        for k in range(2):
+            pressures, gaps, errors = got[k]
+            assert errors[i] <= 1e-11 and gaps[i].min() == 0.0
+            scale = alone.pressures[k].max()
+            assert np.abs(pressures[i] - alone.pressures[k]).max() < 1e-7 * scale
 
 
 def test_validate_runs_on_torch_without_tamaas(monkeypatch, tmp_path):
@@ -266,3 +275,33 @@ def test_a_sweep_resumed_with_another_engine_solves_again(tmp_path):
         first["design_0000"]["max_rel_err"], rel=1e-5
     )
     assert '"engine": "tamaas"' in (out / "design_0000" / "result.json").read_text()
+
+
+def test_a_sweep_solves_designs_as_one_batch(tmp_path, monkeypatch):
+    # three designs of one grid as batches of two (as on a GPU): the same results as one by
+    # one; a batch whose solve fails is solved again design by design
+    designs = [EXAMPLE, _random_design(4), _random_design(5)]
+    kw = dict(grid=48, loads=3, progress=False)
+    single = mi.validate_many(designs, tmp_path / "one", batch=1, **kw)
+    both = mi.validate_many(designs, tmp_path / "batch", batch=2, **kw)
+    for name, s in single.items():
+        assert both[name]["max_rel_err"] == pytest.approx(s["max_rel_err"], rel=1e-6, abs=1e-9)
+
+    def fail(*args, **kwargs):
+        raise ArithmeticError(0, "NaN")
+
+    monkeypatch.setattr(tb, "solve_paths", fail)
+    again = mi.validate_many(designs, tmp_path / "fallback", batch=3, **kw)
+    for name, s in single.items():
+        assert again[name]["max_rel_err"] == pytest.approx(s["max_rel_err"], rel=1e-6, abs=1e-9)
+    with pytest.raises(MetainterfaceError, match="batch > 1 needs engine='torch'"):
+        mi.validate_many(designs, tmp_path / "x", batch=2, chunks=2, **kw)
+
+
+def test_a_failed_solve_is_one_line_naming_the_load(monkeypatch):
+    def nan(*args, **kwargs):
+        raise ArithmeticError("the solve of item 0 produced NaN")
+
+    monkeypatch.setattr(tb, "solve_batch", nan)
+    with pytest.raises(MetainterfaceError, match=r"BEM failed at load 1 of 2 \(P\* = .*finer grid"):
+        validate_design(HERTZ, 32, 2)

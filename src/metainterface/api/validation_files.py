@@ -64,6 +64,7 @@ from metainterface.validation.validate import (
     check_jobs,
     design_target,
     plan_validation,
+    solve_batched,
     validation_request,
 )
 
@@ -450,6 +451,7 @@ def validate_many(
     progress: bool = True,
     engine: str = DEFAULT_ENGINE,
     device: str = "auto",
+    batch: int | None = None,
 ) -> dict[str, dict[str, Any]]:
     """Validate many designs against BEM, on local processes or any executor.
 
@@ -487,6 +489,10 @@ def validate_many(
     engine, device : str
         The contact solver and where torch runs, as in ``validate``. The engine is part of
         each stored request: a sweep resumed with another engine solves its designs again.
+    batch : int
+        Designs of one grid size the torch engine solves together, in this process (no
+        executor, ``chunks=1``). Default: as many as a GPU's memory holds on a GPU, 1 on the
+        CPU (where a batch is no faster).
 
     Returns
     -------
@@ -517,6 +523,15 @@ def validate_many(
         raise MetainterfaceError("give executor or scheduler, not both")
     if scheduler is not None:
         check_scheduler(scheduler)
+    here = executor is None and scheduler is None and chunks == 1 and solver.name == "torch"
+    if batch is not None:
+        batch = _checks.whole("batch", batch, low=1, high=1024)
+        if batch > 1 and not here:
+            raise MetainterfaceError(
+                "batch > 1 needs engine='torch' solving in this process (no executor or "
+                "scheduler, chunks=1)",
+                argument="batch",
+            )
     out = Path(out_dir)
     items = _design_list(designs)
     summaries: dict[str, dict[str, Any]] = {}
@@ -606,6 +621,13 @@ def validate_many(
         if bar is not None:
             bar.update(1)
 
+    if batch is None:
+        batch = 1
+        if here and todo:
+            from metainterface._device import resolve_device
+            from metainterface.validation.torch_bem import batch_size
+
+            batch = batch_size(todo[0].grid, resolve_device(device))
     with contextlib.ExitStack() as stack:
         if scheduler is not None and tasks:  # joined first: a bad address fails before the bar
             executor = stack.enter_context(dask_executor(scheduler, jobs))
@@ -613,14 +635,17 @@ def validate_many(
             from tqdm.auto import tqdm
 
             bar = stack.enter_context(tqdm(total=len(todo), desc="designs", unit="design"))
-        stream(
-            solve_task,
-            tasks,
-            executor=executor,
-            jobs=jobs,
-            on_done=on_done,
-            on_error=on_error,
-            retries=retries,
-        )
+        if batch > 1:  # one task per design: task i is design i
+            solve_batched(todo, batch, fields=fields, on_done=on_done, on_error=on_error)
+        else:
+            stream(
+                solve_task,
+                tasks,
+                executor=executor,
+                jobs=jobs,
+                on_done=on_done,
+                on_error=on_error,
+                retries=retries,
+            )
     write_summary()
     return {n: summaries[n] for n, _ in items}

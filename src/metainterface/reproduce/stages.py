@@ -515,7 +515,8 @@ def _validate(ctx: Context, name: str, design_: Design, target, title: str, text
     ctx.save(
         name,
         plot_validation(res, target=target, title=title),
-        f"{text} Tamaas BEM (Polonsky-Keer-Rey, tolerance {sc.bem_tolerance:g}) on a "
+        f"{text} {'Tamaas' if res.engine == 'tamaas' else 'torch'} BEM (Polonsky-Keer-Rey, "
+        f"tolerance {sc.bem_tolerance:g}) on a "
         f"{res.grid} x {res.grid} grid (the paper: 768) at {len(res.p_star)} loads up to P* at "
         f"Delta_max, against the independent-asperity model. Largest relative error of alpha: "
         f"{_pct(res.max_rel_err)} over all loads, {_pct(res.max_rel_err_upper)} over the upper "

@@ -7,11 +7,11 @@ displacement of a periodic half-space under pressure p is diagonal in Fourier sp
 
     u_hat(q) = 2 p_hat(q) / (E* |q|),   |q| = 2 pi |k| / L,   u_hat(0) = 0,
 
-applied with real FFTs (``torch.fft.rfft2``; the kernel is built once per grid size and
-device). The contact problem (p >= 0, gap g = u - z - c >= 0, p g = 0, mean p = P*) is
-solved by the constrained conjugate gradient of Polonsky & Keer (Wear 231, 1999, 206-219)
-with the mean-pressure constraint of Rey, Anciaux & Molinari (Comput. Mech. 60, 2017,
-69-81): a conjugate gradient on the gap restricted to the points in contact, a projection
+applied with real-input FFTs (half the spectrum; ``displacement``), the kernel built once
+per grid size and device. The contact problem (p >= 0, gap g = u - z - c >= 0, p g = 0,
+mean p = P*) is solved by the constrained conjugate gradient of Polonsky & Keer (Wear 231,
+1999, 206-219) with the mean-pressure constraint of Rey, Anciaux & Molinari (Comput. Mech.
+60, 2017, 69-81): a conjugate gradient on the gap restricted to the points in contact, a projection
 onto p >= 0 that puts pressure back where the surface overlaps, and a rescaling to the
 prescribed mean pressure after each step.
 
@@ -22,7 +22,11 @@ both engines: the complementarity error
 
 sigma_z the standard deviation of the surface, g the (centred) gap of the iteration.
 A load path of ascending pressures starts each solve from the previous pressure field
-rescaled to the new mean (uniform pressure for the first load), as Tamaas does.
+rescaled to the new mean (uniform pressure for the first load), as Tamaas does. Two
+departures from Tamaas, both where it fails: a cold start takes at least two iterations
+(after one, that error reads 0 on a flat punch with the pressure still uniform), and a load
+whose warm start is a contact of one grid point (no conjugate direction: 0 / 0) starts
+again from a uniform pressure instead of failing.
 
 float64 throughout: float32 does not reach the paper's 1e-11. Several height maps of one
 grid size are solved as one batch (``solve_batch``), each item frozen as soon as it
@@ -231,12 +235,14 @@ def solve_paths(
     device: torch.device,
     tolerance: float,
     max_iter: int,
+    on_load: Callable[[int, np.ndarray, np.ndarray, np.ndarray, float], Any],
     check_every: int | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> None:
     """B cells of one grid size along their load paths, solved as one batch per load.
 
-    heights: (B, M, M); cell_sides: (B,); loads: (B, K), ascending along K. Returns
-    (pressures (B, K, M, M), gaps (B, K, M, M), errors (B, K)).
+    heights: (B, M, M); cell_sides: (B,); loads: (B, K), ascending along K. on_load(k,
+    pressures (B, M, M), gaps (B, M, M), errors (B,), seconds) after each load k (numpy).
+    Raises ArithmeticError(k, why) on NaN at load k.
     """
     z = torch.as_tensor(np.ascontiguousarray(heights, dtype=np.float64), device=device)
     b, m, _ = z.shape
@@ -244,19 +250,29 @@ def solve_paths(
     kernel = unit_kernel(m, device)[None] * sides.reshape(b, 1, 1)
     loads = np.asarray(loads, dtype=np.float64)
     every = (1 if device.type == "cpu" else 4) if check_every is None else check_every
-    pressures = np.empty((b, loads.shape[1], m, m))
-    gaps = np.empty_like(pressures)
-    errors = np.empty((b, loads.shape[1]))
     p = None
     for k in range(loads.shape[1]):
+        start = time.perf_counter()
         target = torch.as_tensor(loads[:, k], device=device)
-        p, gap, err, _ = solve_batch(
-            z, kernel, target, p, tolerance=tolerance, max_iter=max_iter, check_every=every
+        try:
+            p, gap, err, _ = solve_batch(
+                z, kernel, target, p, tolerance=tolerance, max_iter=max_iter, check_every=every
+            )
+        except ArithmeticError as exc:
+            raise ArithmeticError(k, str(exc)) from None
+        on_load(
+            k, p.cpu().numpy(), gap.cpu().numpy(), err.cpu().numpy(), time.perf_counter() - start
         )
-        pressures[:, k] = p.cpu().numpy()
-        gaps[:, k] = gap.cpu().numpy()
-        errors[:, k] = err.cpu().numpy()
-    return pressures, gaps, errors
+
+
+def batch_size(grid: int, device: torch.device) -> int:
+    """Designs solved together on ``device``: 1 on the CPU (a batch is no faster there);
+    on a GPU as many as about a quarter of its free memory holds (some 30 M x M float64
+    fields per design), at most 32."""
+    if device.type != "cuda":
+        return 1
+    free, _ = torch.cuda.mem_get_info(device)
+    return int(max(1, min(32, free // 4 // (30 * 8 * grid * grid))))
 
 
 def check_converged(
