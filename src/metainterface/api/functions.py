@@ -13,7 +13,14 @@ import numpy as np
 
 from metainterface import _checks
 from metainterface._files import check_output_file, check_output_folder, output_set
-from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve, idle_notes
+from metainterface.api.results import (
+    CURVE_STEPS,
+    Curve,
+    DesignResult,
+    design_curve,
+    idle_notes,
+    reach_note,
+)
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline
 from metainterface.inverse.perturb import Perturbation
@@ -346,7 +353,7 @@ def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> Desi
     if limit is not None:
         e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
         pressure = check_pressure(d, limit if e_star is None else limit * e_star, e_star=e_star)
-    return DesignResult(
+    out = DesignResult(
         target=r.target,
         design=d,
         error=r.error,
@@ -361,6 +368,8 @@ def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> Desi
         printable=r.quantisation,
         robust_error_refined=r.robust_error,
     )
+    more = reach_note(out.coverage, out.idle, d.n_asperities)
+    return replace(out, notes=(*notes, *more)) if more else out
 
 
 def _physical_options(radius: Any, modulus: Any, total_force: Any, area: Any) -> dict | None:
