@@ -13,6 +13,7 @@ import numpy as np
 
 from metainterface import _checks
 from metainterface._files import check_output_file, check_output_folder, output_set
+from metainterface.api.reach import refuse_unreachable
 from metainterface.api.results import (
     CURVE_STEPS,
     Curve,
@@ -128,6 +129,7 @@ def design(
     scale_sigma: float = 0.0,
     robust_samples: int = 16,
     z_step: float | str | None = None,
+    force: bool = False,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target.
 
@@ -193,6 +195,10 @@ def design(
         gammas re-refined with the heights fixed. A plain number in units of R, or a length
         ('1um') with ``radius``; at most Delta_max. ``result.printable`` reports the error
         before the snap, after it and after the re-refine.
+    force : bool
+        Design a friction-law target that no cell can follow (see :func:`reachability`)
+        anyway: the closest cell, marked ``result.forced``. Without it such a target raises
+        :class:`~metainterface.errors.UnreachableError` before any work.
 
     Returns
     -------
@@ -200,6 +206,11 @@ def design(
         One per target, in order.
     """
     items, single = _targets(targets)
+    if not isinstance(force, bool):
+        raise MetainterfaceError(f"force must be True or False, got {force!r}")
+    if settings is not None and not isinstance(settings, CellSettings):
+        raise MetainterfaceError("settings must be a CellSettings")
+    reach = refuse_unreachable(items, settings, force)  # before any work or file
     if out is not None:  # before any work: a bad folder should not cost a design run
         check_output_folder(out)
     _checks.choice("method", method, pipeline.METHODS)
@@ -207,8 +218,6 @@ def design(
     hedge = _checks.whole("hedge", hedge, low=0, high=MAX_STARTS)
     fallback = _checks.whole("fallback", fallback, low=0, high=MAX_STARTS)
     seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
-    if settings is not None and not isinstance(settings, CellSettings):
-        raise MetainterfaceError("settings must be a CellSettings")
     n = (settings or CellSettings()).n_asperities
     _checks.affordable(
         "starts", starts, (starts + hedge + fallback) * len(items) * n * BYTES_PER_START
@@ -248,6 +257,7 @@ def design(
         z_step=step,
     )
     results = [_public(r, limit, modulus) for r in raw]
+    results = [_forced(r, reach.get(r.target.name)) for r in results]
     if perturb is not None:
         results = [_robust_stats(r, perturb, seed) for r in results]
     if step is not None:
@@ -370,6 +380,16 @@ def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> Desi
     )
     more = reach_note(out.coverage, out.idle, d.n_asperities)
     return replace(out, notes=(*notes, *more)) if more else out
+
+
+def _forced(r: DesignResult, reach: Any) -> DesignResult:
+    """The result marked as forced when its friction law is out of reach."""
+    if reach is None or reach.reachable:
+        return r
+    note = "FORCED: the friction law is out of reach, this is the closest cell; " + (
+        reach.message.replace("\n", " ")
+    )
+    return replace(r, forced=True, notes=(note, *r.notes))
 
 
 def _physical_options(radius: Any, modulus: Any, total_force: Any, area: Any) -> dict | None:
