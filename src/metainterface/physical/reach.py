@@ -163,7 +163,10 @@ def reachability(
     else:
         reach_mu = at_top = (math.nan, math.nan)
     force_unit, mu_name = (" N", "mu") if units else ("", "alpha/P*")
-    law = f"the law's {mu_name} is {_fmt(law_mu.min(), law_mu.max())} ({fn.min():.3g}-{fn.max():.3g}{force_unit})"
+    law = (
+        f"the law's {mu_name} is {_fmt(law_mu.min(), law_mu.max())} "
+        f"({fn.min():.3g}-{fn.max():.3g}{force_unit})"
+    )
     where = f" at E* = {_pa(e_star)}, tau = {_pa(shear_strength)}" if units else ""
     if reachable:
         message = (
@@ -176,7 +179,10 @@ def reachability(
             f"{f_reach:.3g}{force_unit}.\n"
         )
     else:
-        message = f"not reachable: {law};{where} a cell reaches loads up to {f_reach:.3g}{force_unit} only.\n"
+        message = (
+            f"not reachable: {law};{where} a cell reaches loads up to "
+            f"{f_reach:.3g}{force_unit} only.\n"
+        )
     if not reachable:
         message += _advice(p, alpha, lo, hi, within, slack, f_reach, fn, shear_strength, units)
     return Reachability(
