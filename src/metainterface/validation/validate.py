@@ -272,7 +272,8 @@ def _grid_error(
             gamma, h, design.settings, torch.as_tensor(grid)[None], exact=True
         )
     scale = np.interp(grid, loads, np.nan_to_num(ratio, nan=1.0, posinf=1.0))
-    return float(curve_error(alpha[0].numpy() * scale, ref, grid, p_max.numpy())[()])
+    err = curve_error(alpha.numpy() * scale, ref[None], grid[None], p_max.numpy())
+    return float(err[0])
 
 
 def design_target(design: Design) -> tuple[np.ndarray, np.ndarray] | None:
