@@ -547,6 +547,8 @@ def export(
     resolution: float | None = None,
     base: str | float = "1mm",
     z_step: str | float | None = None,
+    flank_step: int = 4,
+    force: bool = False,
 ) -> dict[str, Any]:
     """Write the design's surface for manufacture: STL (mm), 16-bit PNG/TIFF or NPY (m).
 
@@ -570,6 +572,12 @@ def export(
         Delta_max: the asperities' height offsets are snapped to its multiples (a design
         made with ``design(..., z_step=...)`` already sits on them; the sidecar records the
         largest shift).
+    flank_step : int
+        STL only: the flanks between the asperities' contact zones are meshed on every
+        flank_step-th grid line (default 4; 1 meshes every line), in [1, 64].
+    force : bool
+        Write a file over 100 MB; without it such an export raises an error that states
+        the size and how to make it smaller, and writes nothing.
 
     Returns
     -------
@@ -590,7 +598,10 @@ def export(
         from metainterface.api.tolerance import layer_step
 
         step = layer_step(z_step, radius_m, d.settings.delta_max)
-    notes = idle_notes(d)
+    flank_step = _checks.whole("flank_step", flank_step, low=1, high=64)
+    if not isinstance(force, bool):
+        raise MetainterfaceError(f"force must be True or False, got {force!r}")
+    notes = (*idle_notes(d), *_cells_note(d, tiles))
     record = export_design(
         d,
         path,
@@ -601,8 +612,29 @@ def export(
         resolution=resolution,
         base=_checks.number("base", parse_length(base, option="base"), low=1e-6, high=1.0),
         source=source,
+        flank_step=flank_step,
+        force=force,
     )
     return {**record, "notes": list(notes)} if notes else record
+
+
+def _cells_note(d: Design, tiles: Any) -> tuple[str, ...]:
+    """A note when the export's cells are fewer than the design file's physical block says
+    the interface holds."""
+    from metainterface.io.export import parse_tiles
+
+    block = d.extras.get("physical")
+    if not isinstance(block, dict) or "tiles_per_side" not in block:
+        return ()
+    nx, ny = parse_tiles(tiles)
+    per_side = block["tiles_per_side"]
+    if nx >= per_side and ny >= per_side:
+        return ()
+    return (
+        f"this export is {nx}x{ny} unit cells (one cell: {block['cell_side_m'] * 1e3:.4g} mm "
+        f"square, {d.n_asperities} asperities); the design's physical block covers its area "
+        f"with {block['n_cells']:.3g} cells: --tiles {per_side}x{per_side} for the whole patch",
+    )
 
 
 def physical(
