@@ -6,27 +6,26 @@ alpha = F_f / (tau A) at P* = F_n / (A E*), so its friction coefficient is
     mu = F_f / F_n = (alpha / P*) (tau / E*).
 
 A cell of N power-law asperities (gamma in the bounds, each pressed at most Delta_max)
-reaches, at a pressure P*, only contact fractions alpha in [lo(P*), hi(P*)]:
-
-* hi: the load shared equally by all N asperities of the one gamma that gives the most
-  area (each asperity's area is a concave power of its load, F^(2/(gamma + 1)), so an equal
-  share maximises the sum);
-* lo: the load carried by as few asperities as it can be, each full one at Delta_max and
-  one partly loaded (the same concavity makes this extreme allocation the minimum), of the
-  gamma that gives the least area;
-* the largest pressure any cell reaches, P*_reach: all N at Delta_max with the gamma of the
-  largest force.
+reaches, at a pressure P*, only contact fractions alpha in [lo(P*), hi(P*)]. One asperity
+can carry a force f with any gamma whose force at Delta_max reaches f, and gives an area
+between the least and the most of those gammas give; each asperity picks its own gamma
+and share of the load (or none, idle), so the cell's least and most area at a total force
+are the N-fold min-plus and max-plus convolutions of the one-asperity bounds (computed on a
+force grid, cached per cell). The largest pressure any cell reaches, P*_reach, is all N at
+Delta_max with the gamma of the largest force.
 
 So at a pressure P* the reachable friction coefficient is [lo, hi] / P* times tau / E*:
 changing tau / E* scales the law's mu against it, and a larger area lowers the law's P*
-(which moves it along these bounds). Cells of mixed gammas can fall a little outside the
-bounds; a tolerance of ``TOLERANCE`` is allowed before a law is called unreachable.
+(which moves it along these bounds). Pointwise bounds are necessary, not sufficient (one
+cell must follow the whole law); a slack of ``TOLERANCE`` times the law's largest alpha is
+allowed before a point counts as out of reach.
 Closed forms (Sneddon, :mod:`metainterface.physics.sneddon`): for one asperity pressed by d,
 a = (d / (kappa c))^(1/gamma), F = 2 gamma / (gamma + 1) d a, A = pi a^2.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -38,6 +37,8 @@ from metainterface.physics.sneddon import log_kc
 
 #: Shape exponents sampled across [gamma_min, gamma_max] for the bounds.
 GAMMA_SAMPLES = 129
+#: Forces sampled per asperity, 0 to the largest one asperity carries.
+FORCE_SAMPLES = 256
 #: Relative slack on the bounds before a law's point counts as out of reach.
 TOLERANCE = 0.05
 
@@ -49,31 +50,53 @@ def alpha_bounds(
     pressure p_star (M,), and the largest pressure any reaches (lo = inf, hi = -inf beyond
     it, and at P* <= 0)."""
     s = settings or CellSettings()
+    force, lo_n, hi_n = _envelope(s)
     p = np.asarray(p_star, dtype=np.float64)
+    f = p * s.nominal_area
+    reach = float(force[-1] / s.nominal_area)
+    inside = (p > 0) & (p <= reach)
+    lo = np.interp(f, force, lo_n) / s.nominal_area
+    hi = np.interp(f, force, hi_n) / s.nominal_area
+    return np.where(inside, lo, np.inf), np.where(inside, hi, -np.inf), reach
+
+
+@functools.lru_cache(maxsize=8)
+def _envelope(s: CellSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(F, least area, most area) of a whole cell on a uniform force grid [R^2 E* units].
+
+    One asperity can carry a force f with any gamma whose force at Delta_max is >= f; the
+    least and most area it can give are min_gamma / max_gamma A_gamma(f) over those. Each
+    asperity picks its own gamma and share of the load (an idle one carries 0), so the
+    cell's extremes are the N-fold min-plus / max-plus convolutions of those, on a grid of
+    ``FORCE_SAMPLES`` forces per asperity (exact at the grid's points).
+    """
     g = torch.linspace(s.gamma_min, s.gamma_max, GAMMA_SAMPLES, dtype=torch.float64)
     lkc = log_kc(g, s.radius).numpy()
     g = g.numpy()
-    # one asperity: F = c1 d^(1 + 1/gamma), A = pi (d / kc)^(2/gamma)
-    c1 = 2 * g / (g + 1) * np.exp(-lkc / g)
-    f_max = c1 * s.delta_max ** (1 + 1 / g)  # (G,) force of one asperity at Delta_max
-    n = s.n_asperities
-    a_nom = s.nominal_area
+    c1 = 2 * g / (g + 1) * np.exp(-lkc / g)  # F = c1 d^(1 + 1/gamma)
+    f_max = c1 * s.delta_max ** (1 + 1 / g)
+    f = np.linspace(0.0, f_max.max(), FORCE_SAMPLES + 1)
+    d = (f[:, None] / c1) ** (g / (g + 1))
+    area = math.pi * np.exp(2 * (np.log(np.maximum(d, 1e-300)) - lkc) / g) * (d > 0)
+    ok = f[:, None] <= f_max * (1 + 1e-12)
+    low = np.where(ok, area, np.inf).min(1)
+    high = np.where(ok, area, -np.inf).max(1)
+    lo_n, hi_n = low, high
+    for _ in range(s.n_asperities - 1):
+        lo_n = _convolve(lo_n, low, np.minimum)
+        hi_n = _convolve(hi_n, high, np.maximum)
+    force = np.arange(lo_n.size) * (f[1] - f[0])
+    return force, lo_n, hi_n
 
-    def area(f: np.ndarray) -> np.ndarray:  # (M, G) area of one asperity under force f
-        d = (np.maximum(f, 0.0) / c1) ** (g / (g + 1))
-        return math.pi * np.exp(2 * (np.log(np.maximum(d, 1e-300)) - lkc) / g) * (d > 0)
 
-    force = p[:, None] * a_nom  # (M, 1)
-    reach = float(n * f_max.max() / a_nom)
-    share = force / n
-    hi = np.where(share <= f_max * (1 + 1e-12), n * area(share), -np.inf).max(-1) / a_nom
-    full = np.floor(force / f_max)  # asperities at Delta_max, then one partly loaded
-    rest = force - full * f_max
-    lo_g = full * math.pi * (s.delta_max * np.exp(-lkc)) ** (2 / g) + area(rest)
-    fits = (full < n) | ((full == n) & (rest <= 0))
-    lo = np.where(fits, lo_g, np.inf).min(-1) / a_nom
-    inside = (p > 0) & (p <= reach)
-    return np.where(inside, lo, np.inf), np.where(inside, hi, -np.inf), reach
+def _convolve(a: np.ndarray, b: np.ndarray, pick) -> np.ndarray:
+    """(a * b)[j] = pick over i of a[j - i] + b[i]: the min-plus (or max-plus) convolution."""
+    n = a.size + b.size - 1
+    fill = np.inf if pick is np.minimum else -np.inf
+    out = np.full(n, fill)
+    for i, v in enumerate(b):  # len(b) passes over a: ~FORCE_SAMPLES vector operations
+        out[i : i + a.size] = pick(out[i : i + a.size], a + v)
+    return out
 
 
 @dataclass(frozen=True, repr=False)
