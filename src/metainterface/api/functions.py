@@ -196,9 +196,9 @@ def design(
         ('1um') with ``radius``; at most Delta_max. ``result.printable`` reports the error
         before the snap, after it and after the re-refine.
     force : bool
-        Design a friction-law target that no cell can follow (see :func:`reachability`)
-        anyway: the closest cell, marked ``result.forced``. Without it such a target raises
-        :class:`~metainterface.errors.UnreachableError` before any work.
+        Design a friction-law target that no cell can follow anyway (see
+        :func:`~metainterface.reachability`): the closest cell, marked ``result.forced``.
+        Without it such a target raises :class:`~metainterface.UnreachableError` first.
 
     Returns
     -------

@@ -138,7 +138,7 @@ class ValidationResult:
         return float(np.abs(self.alpha_bem_pixels / self.alpha_model - 1.0)[self.upper_half].max())
 
     def target_error(self, alpha: np.ndarray) -> float | None:
-        """The package's curve error (:func:`~metainterface.physics.curves.curve_error`) of
+        """The package's curve error (``physics.curves.curve_error``) of
         alpha (K,), measured at this result's loads, against the design's target; or None
         without a target.
 
