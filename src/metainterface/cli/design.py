@@ -251,13 +251,13 @@ def _table(args: argparse.Namespace, results: list) -> None:
             f"{100 * r.error:>9.3g} %{100 * r.coverage:>8.3g} %"
             f"{f'{r.carrying}/{r.design.n_asperities}':>10}{r.seconds:>9.2f}"
         )
-        if r.forced:
-            line += "  FORCED (out of reach)"
         if r.robust:
             line += f"{100 * r.robust['error_median']:>9.3g} %{100 * r.robust['error_p95']:>9.3g} %"
         if r.printable:
             q = r.printable
             line += f"{100 * q['error_before_snap']:>9.3g} %{100 * q['error_after_snap']:>9.3g} %"
+        if r.forced:
+            line += "  FORCED (out of reach)"
         print(line)
     if args.robust:
         print("error: the nominal design's; made p50/p95: of cells made with the errors given")
