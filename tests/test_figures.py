@@ -113,7 +113,8 @@ def friction_result(tmp_path_factory):
     t = mi.Target.from_friction(
         law, shear_strength="0.25MPa", modulus="2MPa", radius="0.5mm", area="4cm2"
     )
-    return mi.design(t, refine=False, hedge=0, fallback=0)
+    # no cell reaches this law at these E*, tau and area: the figure of a forced design
+    return mi.design(t, refine=False, hedge=0, fallback=0, force=True)
 
 
 @pytest.fixture(scope="module")
@@ -134,6 +135,92 @@ def test_design_figure_friction(friction_result, width):
     assert any("Delta_{max}" in ax.get_title() for ax in fig.axes)
     # the cell's colour legend
     assert any(ax.get_label() == "<colorbar>" for ax in fig.axes)
+
+
+def _tick_overlaps(fig) -> list[str]:
+    """The pairs of tick labels on one axis whose drawn boxes overlap (from the renderer)."""
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    found = []
+    for i, ax in enumerate(fig.axes):
+        for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+            lo, hi = sorted(axis.get_view_interval())
+            boxes = [
+                (label.get_text(), label.get_window_extent(r))
+                for tick in axis.get_major_ticks()
+                if lo - 1e-9 * (hi - lo) <= tick.get_loc() <= hi + 1e-9 * (hi - lo)
+                for label in (tick.label1, tick.label2)
+                if label.get_visible() and label.get_text()
+            ]
+            for (a, ba), (b, bb) in itertools.combinations(boxes, 2):
+                if ba.overlaps(bb):
+                    found.append(f"axes {i} {name}: {a!r} and {b!r}")
+    return found
+
+
+@pytest.mark.parametrize("width", [6.0, None])
+def test_pressure_tick_labels_do_not_run_together(width):
+    """P* up to ~0.01: plain labels ('0.000', '0.003', ...) touched at 6 inches; they are
+    scaled into the axis label instead."""
+    p = np.linspace(0.0, 0.0125, 200)
+    t = mi.Target(p_star=p, alpha=0.9 * (1 - np.exp(-p / 0.004)), name="wide")
+    r = mi.design(t, refine=False, hedge=0, fallback=0)
+    fig = r.figure(width=width)
+    assert _tick_overlaps(fig) == []
+    area = next(ax for ax in fig.axes if ax.get_title() == "contact area")
+    assert "10^{-2}" in area.get_xlabel()
+
+
+def test_tick_overlap_check_sees_labels_running_together():
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(3.0, 2.5), layout="constrained")
+    ax = fig.add_subplot()
+    ax.plot([0, 0.0125], [0, 1])
+    ax.set_xticks(np.linspace(0, 0.0125, 6))
+    ax.ticklabel_format(axis="x", style="plain")
+    assert _tick_overlaps(fig)
+
+
+@pytest.fixture(scope="module")
+def stopping_result(tmp_path_factory):
+    """F_f = 0.4 F_n up to 6 N at E* = 2 MPa, tau = 0.25 MPa on 4 cm^2: out of reach (a cell
+    reaches mu >= ~1.8 and ~4.6 N there), designed anyway."""
+    law = tmp_path_factory.mktemp("stop") / "constant.csv"
+    fn = np.linspace(0.25, 6.0, 24)
+    law.write_text("normal_force,friction_force\n" + "".join(f"{a},{0.4 * a}\n" for a in fn))
+    t = mi.Target.from_friction(
+        law, shear_strength="0.25MPa", modulus="2MPa", radius="0.5mm", area="4cm2"
+    )
+    return mi.design(t, hedge=0, fallback=0, force=True)
+
+
+def test_design_figure_shows_where_a_design_stops(stopping_result):
+    """A design that stops short of its law: both friction panels mark where (in newtons),
+    the coefficient panel holds the design's mu, idle asperities are marked, the title says
+    it was forced and gives the coverage."""
+    r = stopping_result
+    assert r.forced and r.coverage < 1
+    fig = r.figure()
+    title = fig.get_suptitle()
+    assert "FORCED" in title and "coverage" in title
+    by_title = {ax.get_title(): ax for ax in fig.axes}
+    for name in ("friction", "friction coefficient"):
+        labels = [ln.get_label() for ln in by_title[name].get_lines()]
+        assert any(lb.startswith("design stops") and lb.endswith(" N") for lb in labels)
+    ax_m = by_title["friction coefficient"]
+    design_line = next(ln for ln in ax_m.get_lines() if ln.get_label() == "design")
+    x, mu = design_line.get_data()
+    later = x >= 0.1 * x.max()
+    assert mu[later].max() <= ax_m.get_ylim()[1]
+    for name in ("contact area", "stiffness"):
+        assert "design stops" in [ln.get_label() for ln in by_title[name].get_lines()]
+    check_figure(fig)
+    if r.idle:
+        cell = next(ax for ax in fig.axes if ax.get_title().startswith("cell from above"))
+        assert "idle" in cell.get_title()
+        assert sum("idle" in t.get_text() for t in cell.texts) == len(r.idle)
 
 
 @pytest.mark.parametrize("width", [SMALL, LARGE])

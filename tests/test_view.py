@@ -36,11 +36,11 @@ def design_folder(tmp_path_factory):
     """A design of a friction law in newtons, written by the CLI with --html."""
     pytest.importorskip("plotly", reason="the HTML view needs the [view] extra (plotly)")
     folder = tmp_path_factory.mktemp("view")
-    fn = np.linspace(0.05, 2.0, 12)
+    fn = np.linspace(0.1, 2.4, 12)  # mu from 10 to 4: within a cell's reach here
     law = folder / "law.csv"
     law.write_text(
         "normal_force,friction_force\n"
-        + "".join(f"{a},{b}\n" for a, b in zip(fn, 1.2 * fn**0.7, strict=True))
+        + "".join(f"{a},{b}\n" for a, b in zip(fn, 5.2 * fn**0.7, strict=True))
     )
     out = folder / "out"
     args = ["design", "--friction-csv", str(law), "--shear-strength", "0.25MPa"]

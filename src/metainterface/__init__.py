@@ -18,7 +18,8 @@ Start here::
 Targets and designs
     Target, Design, CellSettings
 Designing
-    design, compare, DesignResult, pressure_check, physical
+    design, compare, DesignResult, pressure_check, physical, reachability (can a cell
+    follow this friction law at this E*, tau and area?), Reachability, UnreachableError
 Curves and forward models
     curve, Curve, ForwardModel, Independent, Interacting, MODELS, get_model, register_model
 Checking and making
@@ -77,6 +78,9 @@ _HOMES: dict[str, str] = {
     "view": "metainterface.api",
     "write_result": "metainterface.api",
     "MetainterfaceError": "metainterface.errors",
+    "UnreachableError": "metainterface.errors",
+    "Reachability": "metainterface.physical.reach",
+    "reachability": "metainterface.api.reach",
     "Target": "metainterface.inverse.targets",
     "CellSettings": "metainterface.physics.cell",
     "Design": "metainterface.physics.cell",
@@ -113,8 +117,10 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         view,
         write_result,
     )
-    from metainterface.errors import MetainterfaceError
+    from metainterface.api.reach import reachability
+    from metainterface.errors import MetainterfaceError, UnreachableError
     from metainterface.inverse.targets import Target
+    from metainterface.physical.reach import Reachability
     from metainterface.physics.cell import CellSettings, Design
     from metainterface.physics.models import (
         MODELS,
@@ -172,9 +178,11 @@ __all__ = [
     "Interacting",
     "MetainterfaceError",
     "PrinterSizing",
+    "Reachability",
     "Target",
     "ToleranceResult",
     "TrainConfig",
+    "UnreachableError",
     "ValidationResult",
     "__version__",
     "compare",
@@ -187,6 +195,7 @@ __all__ = [
     "min_radius",
     "physical",
     "pressure_check",
+    "reachability",
     "register_model",
     "tolerance",
     "train_surrogate",

@@ -17,3 +17,13 @@ class MetainterfaceError(ValueError):
     def __init__(self, message: str = "", *, argument: str | None = None) -> None:
         super().__init__(message)
         self.argument = argument
+
+
+class UnreachableError(MetainterfaceError):
+    """A friction law no cell in the design space can follow; ``reachability`` says why
+    (the law's friction coefficient, the reachable one and what would make it reachable)."""
+
+    def __init__(self, message: str = "", *, reachability: object = None, target: str = "") -> None:
+        super().__init__(message)
+        self.reachability = reachability
+        self.target = target

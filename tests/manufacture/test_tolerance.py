@@ -116,20 +116,22 @@ def test_a_design_result_is_measured_to_its_own_target():
     assert "target saturating" in s.settings["reference"]
 
 
-def test_nominal_error_of_a_design_that_stops_short_is_held_as_design_measures_it():
+def test_nominal_error_of_a_design_that_stops_short_is_charged_its_coverage():
     # one asperity reaches P*_max at Delta_max; a target running on to 1.5 P*_max is met
-    # exactly below it, and above it the design's curve stays at its last value
+    # exactly below it: the fit there is ~0, the third of the load range it misses is
+    # charged in full, error = sqrt(0 + (1 - 1/1.5)^2) = 1/3, as design measures it
     d = mi.Design(gamma=[2.7], h=[0.0], settings=mi.CellSettings(n_asperities=1))
     side = d.settings.cell_side
     p_max = float(mi.curve(d).p_star.max())
     p = np.linspace(0.0, 1.5 * p_max, 2001)[1:]
     exact = single_alpha(2.7, p, side)
-    held = single_alpha(2.7, np.minimum(p, p_max), side)
-    expect = np.linalg.norm(held - exact) / np.linalg.norm(exact)
     target = mi.Target(p_star=p, alpha=exact, name="beyond")
     r = mi.tolerance(d, sigma_h=0.0, samples=16, target=target)
-    assert expect > 0.02
-    assert r.error_nominal == pytest.approx(expect, rel=0.03)
+    assert r.error_nominal == pytest.approx(1 / 3, rel=1e-3)
+    assert r.coverage == pytest.approx(1 / 1.5, rel=1e-6) and r.carrying == 1
+    # made cells are loaded past Delta_max: the same curve, all the range covered
+    assert np.all(r.errors < 1e-3)
+    assert "coverage 66.7 %" in repr(r)
 
 
 def test_units_need_a_radius_and_scale_by_it():

@@ -50,3 +50,14 @@ def test_round_trip_keeps_extras_and_defaults(tmp_path):
 def test_bad_files(tmp_path, data, message):
     with pytest.raises(MetainterfaceError, match=message):
         Design.load(write(tmp_path, data))
+
+
+def test_design_has_its_delta_max_and_plain_ints():
+    import numpy as np
+
+    from metainterface.physics.cell import CellSettings, Design
+
+    d = Design(gamma=[2.0] * 4, h=[0.0] * 4, settings=CellSettings(n_asperities=np.int64(4)))
+    assert d.delta_max == d.settings.delta_max == 0.02
+    assert type(d.settings.n_asperities) is int and "np." not in repr(d.settings)
+    assert type(d.n_asperities) is int

@@ -14,7 +14,15 @@ import numpy as np
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_file, check_output_folder, output_set
-from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve, idle_notes
+from metainterface.api.reach import refuse_unreachable
+from metainterface.api.results import (
+    CURVE_STEPS,
+    Curve,
+    DesignResult,
+    design_curve,
+    idle_notes,
+    reach_note,
+)
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline
 from metainterface.inverse.perturb import Perturbation
@@ -123,6 +131,7 @@ def design(
     robust_samples: int = 16,
     z_step: float | str | None = None,
     device: str = "auto",
+    force: bool = False,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target.
 
@@ -192,6 +201,10 @@ def design(
         Where the refinement runs: ``"auto"`` (CUDA when torch sees it, else the CPU),
         ``"cpu"``, ``"cuda"`` or ``"cuda:N"``. Every target's starts go in one batch; the
         starts are drawn on the CPU, so a seed gives the same starts on every device.
+    force : bool
+        Design a friction-law target that no cell can follow anyway (see
+        :func:`~metainterface.reachability`): the closest cell, marked ``result.forced``.
+        Without it such a target raises :class:`~metainterface.UnreachableError` first.
 
     Returns
     -------
@@ -199,6 +212,11 @@ def design(
         One per target, in order.
     """
     items, single = _targets(targets)
+    if not isinstance(force, bool):
+        raise MetainterfaceError(f"force must be True or False, got {force!r}")
+    if settings is not None and not isinstance(settings, CellSettings):
+        raise MetainterfaceError("settings must be a CellSettings")
+    reach = refuse_unreachable(items, settings, force)  # before any work or file
     if out is not None:  # before any work: a bad folder should not cost a design run
         check_output_folder(out)
     _checks.choice("method", method, pipeline.METHODS)
@@ -206,8 +224,6 @@ def design(
     hedge = _checks.whole("hedge", hedge, low=0, high=MAX_STARTS)
     fallback = _checks.whole("fallback", fallback, low=0, high=MAX_STARTS)
     seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
-    if settings is not None and not isinstance(settings, CellSettings):
-        raise MetainterfaceError("settings must be a CellSettings")
     n = (settings or CellSettings()).n_asperities
     dev = resolve_device(device)
     _affordable_rows(method, starts, hedge, fallback, len(items), n, dev)
@@ -247,6 +263,7 @@ def design(
         device=dev,
     )
     results = [_public(r, limit, modulus) for r in raw]
+    results = [_forced(r, reach.get(r.target.name)) for r in results]
     if perturb is not None:
         results = [_robust_stats(r, perturb, seed, dev) for r in results]
     if step is not None:
@@ -381,7 +398,7 @@ def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> Desi
     if limit is not None:
         e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
         pressure = check_pressure(d, limit if e_star is None else limit * e_star, e_star=e_star)
-    return DesignResult(
+    out = DesignResult(
         target=r.target,
         design=d,
         error=r.error,
@@ -396,6 +413,18 @@ def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> Desi
         printable=r.quantisation,
         robust_error_refined=r.robust_error,
     )
+    more = reach_note(out.coverage, out.idle, d.n_asperities)
+    return replace(out, notes=(*notes, *more)) if more else out
+
+
+def _forced(r: DesignResult, reach: Any) -> DesignResult:
+    """The result marked as forced when its friction law is out of reach."""
+    if reach is None or reach.reachable:
+        return r
+    note = "FORCED: the friction law is out of reach, this is the closest cell; " + (
+        reach.message.replace("\n", " ")
+    )
+    return replace(r, forced=True, notes=(note, *r.notes))
 
 
 def _physical_options(radius: Any, modulus: Any, total_force: Any, area: Any) -> dict | None:
@@ -557,6 +586,8 @@ def export(
     resolution: float | None = None,
     base: str | float = "1mm",
     z_step: str | float | None = None,
+    flank_step: int = 4,
+    force: bool = False,
 ) -> dict[str, Any]:
     """Write the design's surface for manufacture: STL (mm), 16-bit PNG/TIFF or NPY (m).
 
@@ -580,6 +611,12 @@ def export(
         Delta_max: the asperities' height offsets are snapped to its multiples (a design
         made with ``design(..., z_step=...)`` already sits on them; the sidecar records the
         largest shift).
+    flank_step : int
+        STL only: the flanks between the asperities' contact zones are meshed on every
+        flank_step-th grid line (default 4; 1 meshes every line), in [1, 64].
+    force : bool
+        Write a file over 100 MB; without it such an export raises an error that states
+        the size and how to make it smaller, and writes nothing.
 
     Returns
     -------
@@ -600,7 +637,10 @@ def export(
         from metainterface.api.tolerance import layer_step
 
         step = layer_step(z_step, radius_m, d.settings.delta_max)
-    notes = idle_notes(d)
+    flank_step = _checks.whole("flank_step", flank_step, low=1, high=64)
+    if not isinstance(force, bool):
+        raise MetainterfaceError(f"force must be True or False, got {force!r}")
+    notes = (*idle_notes(d), *_cells_note(d, tiles))
     record = export_design(
         d,
         path,
@@ -611,8 +651,29 @@ def export(
         resolution=resolution,
         base=_checks.number("base", parse_length(base, option="base"), low=1e-6, high=1.0),
         source=source,
+        flank_step=flank_step,
+        force=force,
     )
     return {**record, "notes": list(notes)} if notes else record
+
+
+def _cells_note(d: Design, tiles: Any) -> tuple[str, ...]:
+    """A note when the export's cells are fewer than the design file's physical block says
+    the interface holds."""
+    from metainterface.io.export import parse_tiles
+
+    block = d.extras.get("physical")
+    if not isinstance(block, dict) or "tiles_per_side" not in block:
+        return ()
+    nx, ny = parse_tiles(tiles)
+    per_side = block["tiles_per_side"]
+    if nx >= per_side and ny >= per_side:
+        return ()
+    return (
+        f"this export is {nx}x{ny} unit cells (one cell: {block['cell_side_m'] * 1e3:.4g} mm "
+        f"square, {d.n_asperities} asperities); the design's physical block covers its area "
+        f"with {block['n_cells']:.3g} cells: --tiles {per_side}x{per_side} for the whole patch",
+    )
 
 
 def physical(

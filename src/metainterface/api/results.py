@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import io
 import os
@@ -177,6 +178,50 @@ def idle_notes(design: Design) -> tuple[str, ...]:
     )
 
 
+def reach_counts(
+    design: Design,
+    model: str | ForwardModel | None = None,
+    target: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[float, tuple[int, ...]]:
+    """(coverage, idle) of a design against a target's (p_star, alpha), under a model.
+
+    coverage: the fraction of the target's load range the design reaches
+    (:func:`~metainterface.physics.curves.coverage`; 1.0 without a target). idle: indices
+    of the asperities that carry no load, never touching within Delta_max or, with a
+    target, only past its largest load (:func:`~metainterface.physics.curves.idle_mask`).
+    """
+    from metainterface.physics.curves import coverage, idle_mask
+
+    m = get_model(model)
+    gamma, h = design.tensors(torch.float64)
+    s = design.settings
+    with torch.no_grad():
+        ends = torch.tensor([[0.0, s.delta_max]], dtype=torch.float64)
+        p_max = m.sweep(gamma, h, s, delta=ends).p_star[:, -1]
+        if target is None:
+            return 1.0, tuple(int(i) for i in np.flatnonzero(design.idle))
+        p_t = torch.as_tensor(np.asarray(target[0], dtype=np.float64))[None]
+        cov = float(coverage(p_t, p_max)[0])
+        idle = idle_mask(gamma, h, s, p_t[:, -1], sweep_fn=m.sweep)[0].numpy()
+    return cov, tuple(int(i) for i in np.flatnonzero(idle))
+
+
+def reach_note(coverage: float, idle: tuple[int, ...], n: int) -> tuple[str, ...]:
+    """What a user must know about a design that stops short or has idle asperities."""
+    out = []
+    if coverage < 0.999:
+        out.append(
+            f"the design reaches only {100 * coverage:.3g} % of the target's load range; "
+            "the error charges the rest (coverage)"
+        )
+    if idle:
+        out.append(
+            f"{len(idle)} of {n} asperities (index {', '.join(map(str, idle))}) carry no load "
+            "within Delta_max and the target's load range"
+        )
+    return tuple(out)
+
+
 def _engagement_grid(design: Design, steps: int) -> np.ndarray:
     """(K,) sorted Delta in [0, Delta_max]: ``steps`` uniform ones plus 24 per asperity,
     geometric from 1e-7 to 0.05 Delta_max after its engagement."""
@@ -205,8 +250,9 @@ class DesignResult:
     design : Design
         The cell: numpy ``gamma`` and ``h`` (N,), and its settings.
     error : float
-        Relative curve error ||alpha - alpha_target||_2 / ||alpha_target||_2 at the target's
-        pressures (0.01 = 1 %).
+        The curve error sqrt(fit^2 + (1 - coverage)^2): fit the relative L2 error
+        ||alpha - alpha_target||_2 / ||alpha_target||_2 at the target's pressures the design
+        reaches, coverage below (0.01 = 1 %; docs: concepts/errors).
     initial_error : float
         The same before refinement (the zero-shot prediction's, or the best start's).
     method : str
@@ -232,6 +278,16 @@ class DesignResult:
     printable : dict or None
         With a layer height: ``z_step`` [R] and the error before the snap, after it and
         after the re-refine (``error`` is the last).
+    forced : bool
+        The target was outside the reachable range and designed anyway (``force=True``):
+        the closest design, not a match.
+    coverage : float
+        The fraction of the target's load range (0 to its largest P*) the design reaches.
+    idle : tuple of int
+        Indices of the asperities that carry no load (never touch within Delta_max, or
+        only past the target's largest load).
+    carrying : int
+        The number of load-carrying asperities, N - len(idle).
     """
 
     target: Target
@@ -248,6 +304,23 @@ class DesignResult:
     robust: dict[str, Any] | None = None
     printable: dict[str, Any] | None = None
     robust_error_refined: float | None = None
+    forced: bool = False
+
+    @functools.cached_property
+    def _reach(self) -> tuple[float, tuple[int, ...]]:
+        return reach_counts(self.design, self.model, (self.target.p_star, self.target.alpha))
+
+    @property
+    def coverage(self) -> float:
+        return self._reach[0]
+
+    @property
+    def idle(self) -> tuple[int, ...]:
+        return self._reach[1]
+
+    @property
+    def carrying(self) -> int:
+        return self.design.n_asperities - len(self.idle)
 
     @property
     def origin(self) -> str:
@@ -307,6 +380,11 @@ class DesignResult:
             "model": self.model.label,
             "winning_start": self.origin,
             "relative_error": self.error,
+            "error_definition": "sqrt(fit^2 + (1 - coverage)^2)",
+            "coverage": self.coverage,
+            "idle_asperities": list(self.idle),
+            "carrying_asperities": self.carrying,
+            **({"forced": True} if self.forced else {}),
             "zero_shot_error": self.initial_error,
             "seconds": self.seconds,
             **({"notes": list(self.notes)} if self.notes else {}),
@@ -340,9 +418,12 @@ class DesignResult:
                 f"-> snapped {_percent(q['error_after_snap'])} -> re-refined "
                 f"{_percent(q['error_after_refine'])}"
             )
+        forced = "FORCED (target unreachable), " if self.forced else ""
         return (
-            f"DesignResult(target={self.target.name!r}, method={self.method!r}, "
+            f"DesignResult({forced}target={self.target.name!r}, method={self.method!r}, "
             f"model={self.model.label!r}, error={_percent(self.error)}, "
+            f"coverage={_percent(self.coverage)}, carrying {self.carrying} of "
+            f"{self.design.n_asperities} asperities, "
             f"zero-shot {_percent(self.initial_error)}, {self.seconds:.2f} s{made}, "
             f"design={self.design!r}{note})"
         )

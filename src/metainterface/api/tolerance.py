@@ -10,6 +10,7 @@ within a budget (the design's heights scale with R, the printer's error does not
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import os
 import time
@@ -212,6 +213,31 @@ class ToleranceResult:
     modulus: float | None = None
     seconds: float = 0.0
     printer: dict[str, Any] | None = field(default=None)
+    forward_model: ForwardModel | None = None
+
+    @functools.cached_property
+    def _reach(self) -> tuple[float, tuple[int, ...]]:
+        from metainterface.api.results import reach_counts
+
+        ref = self.reference
+        return reach_counts(
+            self.design, self.forward_model, None if ref is None else (ref.p_star, ref.alpha)
+        )
+
+    @property
+    def coverage(self) -> float:
+        """The fraction of the reference's load range the nominal design reaches."""
+        return self._reach[0]
+
+    @property
+    def idle(self) -> tuple[int, ...]:
+        """Indices of the nominal design's asperities that carry no load."""
+        return self._reach[1]
+
+    @property
+    def carrying(self) -> int:
+        """The number of the nominal design's load-carrying asperities."""
+        return self.design.n_asperities - len(self.idle)
 
     def band(self) -> dict[str, np.ndarray]:
         """The columns of band.csv."""
@@ -224,6 +250,10 @@ class ToleranceResult:
             "error_p95": self.error_p95,
             "error_nominal": self.error_nominal,
             "error_mean": float(np.mean(self.errors)),
+            "error_definition": "sqrt(fit^2 + (1 - coverage)^2)",
+            "coverage": self.coverage,
+            "idle_asperities": list(self.idle),
+            "carrying_asperities": self.carrying,
             "first_order": {
                 "error_median": self.error_median_linear,
                 "error_p95": self.error_p95_linear,
@@ -271,7 +301,8 @@ class ToleranceResult:
         return (
             f"ToleranceResult({s.samples} samples, {sig}, sigma_gamma={s.sigma_gamma:g}, "
             f"scale_sigma={s.scale_sigma:g}, {s.model}; error to {s.reference}: "
-            f"nominal {_pc(self.error_nominal)}, median {_pc(self.error_median)}, "
+            f"nominal {_pc(self.error_nominal)} (coverage {_pc(self.coverage)}, carrying "
+            f"{self.carrying} of {self.design.n_asperities}), median {_pc(self.error_median)}, "
             f"p95 {_pc(self.error_p95)} (first order: median {_pc(self.error_median_linear)}, "
             f"p95 {_pc(self.error_p95_linear)}))"
         )
@@ -435,6 +466,7 @@ def tolerance(
         shear_strength=tau,
         modulus=e_star,
         seconds=time.perf_counter() - t0,
+        forward_model=fm,
     )
     if out is not None:
         result.save(out)

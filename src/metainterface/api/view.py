@@ -126,7 +126,13 @@ def _collect(source: Any, path: str | os.PathLike[str] | None) -> dict[str, Any]
     summary = [
         ("method", str(record.get("method", "given"))),
         ("forward model of the curves", drawn),
-        *([("relative error", f"{100 * float(error):.3g} %")] if error is not None else []),
+        *([("curve error", f"{100 * float(error):.3g} %")] if error is not None else []),
+        *(
+            [("coverage of the load range", f"{100 * float(record['coverage']):.3g} %")]
+            if isinstance(record.get("coverage"), int | float)
+            else []
+        ),
+        *([("FORCED", "the target is out of reach")] if record.get("forced") else []),
         ("asperities", f"{design.gamma.size} ({st.n_side} x {st.n_side})"),
         ("shape exponents γ", f"{design.gamma.min():.3f} to {design.gamma.max():.3f}"),
         ("height offsets h / Δmax", f"0 to {h0.max():.3g}"),

@@ -120,6 +120,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "re-refined; the error before and after is reported",
     )
     p.add_argument(
+        "--force",
+        action="store_true",
+        help="design a friction law that no cell can follow anyway (the closest cell, marked "
+        "as forced); without it such a law exits with status 2, writing nothing",
+    )
+    p.add_argument(
         "--max-pressure",
         help="peak contact pressure limit: p/E* (number) or a stress with --modulus",
     )
@@ -182,8 +188,36 @@ def run(args: argparse.Namespace) -> int:
         meta=_command(args),
         full_target=args.full_target,
         device=args.device,
+        force=args.force,
         **_manufacturing(args),
     )
+    try:
+        results = _run(args, targets, options)
+    except mi.UnreachableError as exc:  # two lines: what is out of reach, what would fix it
+        head, _, advice = exc.reachability.message.partition("\n")
+        print(f"metainterface design: error: {exc.target}: {head}", file=sys.stderr)
+        print(f"{advice} --force designs the closest cell anyway.".strip(), file=sys.stderr)
+        return 2
+    for r in results:
+        for note in r.notes:
+            print(f"warning: {note}", file=sys.stderr)
+        if r.pressure is not None:
+            print(f"{r.target.name} ({r.method}): {r.pressure.summary()}")
+    _table(args, results)
+    if args.html:  # one page per design folder
+        from pathlib import Path
+
+        out = Path(args.out)
+        for r in results:
+            page = mi.view(out if len(results) == 1 else out / r.target.name)
+            print(f"{page}: interactive view, opens in a browser")
+    print(f"written to {args.out}")
+    return 0
+
+
+def _run(args: argparse.Namespace, targets: list, options: dict) -> list:
+    import metainterface as mi
+
     if args.compare:
         if args.html:
             raise mi.MetainterfaceError("--html draws one design per page; leave out --compare")
@@ -198,13 +232,16 @@ def run(args: argparse.Namespace) -> int:
             **options,
         )
         results = made if isinstance(made, list) else [made]
-    for r in results:
-        for note in r.notes:
-            print(f"warning: {note}", file=sys.stderr)
-        if r.pressure is not None:
-            print(f"{r.target.name} ({r.method}): {r.pressure.summary()}")
+    return results
+
+
+def _table(args: argparse.Namespace, results: list) -> None:
+    """The summary table: errors (the one curve error), coverage and carrying asperities."""
     width = max(len("target"), *(len(r.target.name) for r in results)) + 2
-    head = f"{'target':<{width}}{'method':<12}{'zero-shot':>11}{'error':>11}{'seconds':>9}"
+    head = (
+        f"{'target':<{width}}{'method':<12}{'zero-shot':>11}{'error':>11}{'coverage':>10}"
+        f"{'carrying':>10}{'seconds':>9}"
+    )
     if args.robust:
         head += f"{'made p50':>11}{'made p95':>11}"
     if args.z_step is not None:
@@ -213,13 +250,16 @@ def run(args: argparse.Namespace) -> int:
     for r in results:
         line = (
             f"{r.target.name:<{width}}{r.method:<12}{100 * r.initial_error:>9.3g} %"
-            f"{100 * r.error:>9.3g} %{r.seconds:>9.2f}"
+            f"{100 * r.error:>9.3g} %{100 * r.coverage:>8.3g} %"
+            f"{f'{r.carrying}/{r.design.n_asperities}':>10}{r.seconds:>9.2f}"
         )
         if r.robust:
             line += f"{100 * r.robust['error_median']:>9.3g} %{100 * r.robust['error_p95']:>9.3g} %"
         if r.printable:
             q = r.printable
             line += f"{100 * q['error_before_snap']:>9.3g} %{100 * q['error_after_snap']:>9.3g} %"
+        if r.forced:
+            line += "  FORCED (out of reach)"
         print(line)
     if args.robust:
         print("error: the nominal design's; made p50/p95: of cells made with the errors given")
@@ -228,15 +268,10 @@ def run(args: argparse.Namespace) -> int:
             "unsnapped/snapped: before the snap to the layer grid and right after it; error: "
             "after the shapes were re-refined"
         )
-    if args.html:  # one page per design folder
-        from pathlib import Path
-
-        out = Path(args.out)
-        for r in results:
-            page = mi.view(out if len(results) == 1 else out / r.target.name)
-            print(f"{page}: interactive view, opens in a browser")
-    print(f"written to {args.out}")
-    return 0
+    print(
+        "error: sqrt(fit^2 + (1 - coverage)^2), fit over the loads the design reaches; "
+        "coverage: the share of the target's load range it reaches"
+    )
 
 
 def _manufacturing(args: argparse.Namespace) -> dict:

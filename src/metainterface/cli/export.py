@@ -38,6 +38,20 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="LENGTH",
         help="printer layer height, e.g. 1um: the asperities' heights snapped to its multiples",
     )
+    p.add_argument(
+        "--flank-step",
+        type=int,
+        default=4,
+        metavar="K",
+        help="STL: mesh the flanks between the asperities' contact zones on every K-th grid "
+        "line (default 4; 1 = every line)",
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="write a file over 100 MB (without it the export states the size and how to "
+        "make it smaller, and writes nothing)",
+    )
     p.set_defaults(func=run)
 
 
@@ -67,6 +81,8 @@ def run(args: argparse.Namespace) -> int:
         resolution=resolution,
         base=parse_length(args.base, option="--base"),
         z_step=args.z_step,  # checked against the design's Delta_max by export
+        flank_step=args.flank_step,
+        force=args.force,
     )
     for note in rec.get("notes", ()):
         print(f"warning: {note}", file=sys.stderr)
@@ -84,4 +100,5 @@ def run(args: argparse.Namespace) -> int:
             f"(largest shift {z['largest_shift_m'] * 1e6:.3g} um)"
         )
     print(f"{args.out}: {rec['format']} of {nx}x{ny} cells, {size}, {detail}")
+    print(f"one cell: {rec['one_cell']}")
     return 0

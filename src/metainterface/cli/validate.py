@@ -158,8 +158,10 @@ def run(args: argparse.Namespace) -> int:
     errors = result.target_errors()
     if errors is not None:
         print(
-            f"error against the design's target at these loads: BEM {100 * errors[0]:.3g} %, "
-            f"{result.model.label} model {100 * errors[1]:.3g} %"
+            f"curve error against the design's target: BEM {100 * errors[0]:.3g} %, "
+            f"{result.model.label} model {100 * errors[1]:.3g} % (coverage "
+            f"{100 * result.coverage:.3g} %, {result.carrying} of "
+            f"{result.design.n_asperities} asperities carry load)"
         )
     return 0
 

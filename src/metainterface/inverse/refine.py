@@ -27,7 +27,7 @@ from metainterface.inverse import lbfgs, levmar
 from metainterface.inverse.params import DTYPE, FULL, Parameterisation
 from metainterface.inverse.perturb import Perturbation, loaded
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import at_delta, interp_weights, relative_l2, solve_delta
+from metainterface.physics.curves import at_delta, curve_error, interp_weights, solve_delta
 from metainterface.physics.models import ForwardModel, get_model
 
 POLISH_METHODS = ("levmar", "lbfgs")
@@ -261,12 +261,12 @@ def relative_error(
     target: TargetGrid,
     model: ForwardModel | None = None,
 ) -> Tensor:
-    """||alpha_design - alpha_target||_2 / ||alpha_target||_2 on the target's grid (exact
-    law, alpha exact at the target's pressures, the design's curve held at its last value
-    where it stops short). (B,)."""
+    """The package's curve error (:func:`~metainterface.physics.curves.curve_error`) on the
+    target's grid: the relative L2 error where the design reaches (exact law, alpha exact
+    at the target's pressures), combined with the share of the load range it misses. (B,)."""
     with torch.no_grad():
-        alpha, _ = get_model(model).alpha_at(gamma, h, settings, target.p, exact=True)
-        return relative_l2(alpha, target.alpha)
+        alpha, p_max = get_model(model).alpha_at(gamma, h, settings, target.p, exact=True)
+        return curve_error(alpha, target.alpha, target.p, p_max)
 
 
 def robust_error(

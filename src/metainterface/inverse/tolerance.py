@@ -12,11 +12,11 @@ with sigma_h in units of R. Heights are anchored by the forward model: Delta is 
 from the first contact of the made part, so only relative height errors matter. The scale
 error scales the height offsets only; the tips' own shapes carry the gamma error.
 
-Errors are the package's relative curve error (exact alpha at the reference's pressures),
-with one difference from ``design``'s: a made cell that needs a deeper indentation than
-Delta_max to reach a pressure is loaded further (up to ``REACH`` Delta_max) instead of
-having its alpha held at its last value, since Delta_max bounds the design space, not the
-part.
+Errors are the package's curve error (:func:`~metainterface.physics.curves.curve_error`,
+exact alpha at the reference's pressures), with one difference from ``design``'s: a made
+cell that needs a deeper indentation than Delta_max to reach a pressure is loaded further
+(up to ``REACH`` Delta_max) instead of having its alpha held at its last value, since
+Delta_max bounds the design space, not the part.
 
 All samples go through the batched forward model in one call; the first-order estimate
 linearises alpha at the nominal design by autograd (one backward pass through a batch of
@@ -37,7 +37,7 @@ from metainterface.inverse.params import DTYPE
 from metainterface.inverse.perturb import Perturbation, loaded
 from metainterface.inverse.refine import TargetGrid, relative_error
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import relative_l2
+from metainterface.physics.curves import curve_error
 from metainterface.physics.models import ForwardModel
 
 #: Bisection steps (in log sigma_h) of the radius search: the bracket [1e-6, 10] Delta_max,
@@ -127,7 +127,7 @@ def spread(
     p_all = torch.cat([grid, ref.p[0]])[None]
     g_s, h_s = pert.apply(g0, h0)
     with torch.no_grad():
-        alpha, _ = model.alpha_at(
+        alpha, reach = model.alpha_at(
             torch.cat([g0, g_s]),
             torch.cat([h0, h_s]),
             settings,
@@ -135,7 +135,7 @@ def spread(
             exact=True,
         )
     band, at_ref = alpha[:, :m], alpha[:, m:]
-    errors = relative_l2(at_ref, ref.alpha)
+    errors = curve_error(at_ref, ref.alpha.expand_as(at_ref), ref.p.expand_as(at_ref), reach)
     # the nominal error as design reports it: on the design's own Delta range (held at its
     # last value where it stops short), not loaded further like the made cells
     nominal = relative_error(g0, h0, own_settings, ref, model)

@@ -45,6 +45,13 @@ POINTS_PER_PITCH = 64
 MAX_SIDE_POINTS = 8192
 MAX_STL_TRIANGLES = 8_000_000
 _LEVELS = 65535
+#: Files larger than this [bytes] are written only when asked (``force``): the size is
+#: stated first, with ways to make the file smaller.
+LARGE_FILE_BYTES = 100 * 10**6
+#: STL flanks: outside the contact zone of each asperity (a_max from its centre, with this
+#: margin) the surface is meshed on every FLANK_STEP-th grid line only by default.
+FLANK_STEP = 4
+CONTACT_MARGIN = 1.15
 
 
 @dataclass(frozen=True)
@@ -61,6 +68,7 @@ class Patch:
     grid: int
     tiles: tuple[int, int]
     cell_side: float
+    n_side: int = 1
 
     @property
     def size(self) -> tuple[float, float]:
@@ -153,7 +161,42 @@ def height_patch(
         grid=cell.grid,
         tiles=(nx, ny),
         cell_side=cell.cell_side * scale,
+        n_side=design.settings.n_side,
     )
+
+
+def mesh_lines(patch: Patch, flank_step: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """The grid lines (node indices along x and y, 0 .. nx M inclusive, the last closing
+    the period) an STL of the patch is meshed on: every line through an asperity's
+    contact zone (within CONTACT_MARGIN a_max of its centre line, a_max = pitch / 4), every
+    ``flank_step``-th across the flanks between them, and the patch's edges."""
+    ny, nx = patch.heights.shape
+    m = patch.grid // patch.n_side  # grid points per asperity pitch
+
+    def lines(count: int) -> np.ndarray:
+        i = np.arange(count + 1)
+        offset = (i % m) / m - 0.5  # from the centre line, in pitches (-0.5 .. 0.5)
+        fine = np.abs(offset) <= CONTACT_MARGIN / 4 + 0.5 / m
+        keep = fine | (i % max(1, flank_step) == 0) | (i == count)
+        return np.flatnonzero(keep)
+
+    return lines(nx), lines(ny)
+
+
+def stl_triangles(n_x: int, n_y: int) -> int:
+    """Triangles of an STL meshed on n_x x n_y grid lines: the top, the four walls and the
+    bottom fan (see :func:`patch_mesh`)."""
+    loop = 2 * (n_x - 1) + 2 * (n_y - 1)
+    return 2 * (n_x - 1) * (n_y - 1) + 3 * loop
+
+
+def file_bytes(patch: Patch, fmt: str, flank_step: int = 1) -> int:
+    """The size of the export [bytes] (at most, for the compressed PNG)."""
+    ny, nx = patch.heights.shape
+    if fmt == "stl":
+        lx, ly = mesh_lines(patch, flank_step)
+        return 84 + 50 * stl_triangles(lx.size, ly.size)
+    return nx * ny * (8 if fmt == "npy" else 2) + 1024
 
 
 def _require(module: str, what: str) -> Any:
@@ -169,27 +212,30 @@ def _require(module: str, what: str) -> Any:
         ) from None
 
 
-def patch_mesh(patch: Patch, base: float) -> Any:
+def patch_mesh(patch: Patch, base: float, flank_step: int = 1) -> Any:
     """A watertight trimesh.Trimesh of the patch on a base plate, in millimetres.
 
     base: plate thickness under the lowest surface point [m], > 0. The bottom face is at
     z = 0, the grid spans [0, nx L R] x [0, ny L R]; the last row and column close the
-    period (they repeat the first). Faces are wound outwards.
+    period (they repeat the first). Faces are wound outwards. flank_step: mesh the flanks
+    between the asperities' contact zones on every flank_step-th grid line only
+    (:func:`mesh_lines`; 1 = every line); a tensor grid, so it stays watertight.
     """
     trimesh = _require("trimesh", "STL")
     if not (math.isfinite(base) and base > 0):
         raise MetainterfaceError(f"--base must be > 0 for an STL, got {base!r}")
-    ny, nx = patch.heights.shape  # cells of the surface grid; nodes are one more each way
-    n_tri = 2 * nx * ny + 6 * (nx + ny)
+    cols, rows = mesh_lines(patch, flank_step)
+    n_tri = stl_triangles(cols.size, rows.size)
     if n_tri > MAX_STL_TRIANGLES:
         raise MetainterfaceError(
             f"the STL would have {n_tri} triangles, above {MAX_STL_TRIANGLES}: "
-            f"lower --resolution or --tiles"
+            f"lower --resolution or --tiles, or raise --flank-step"
         )
-    z = np.pad(patch.heights, ((0, 1), (0, 1)), mode="wrap")
+    z = np.pad(patch.heights, ((0, 1), (0, 1)), mode="wrap")[np.ix_(rows, cols)]
+    ny, nx = rows.size - 1, cols.size - 1  # cells of the mesh; nodes are one more each way
     z_mm = (z - z.min()) * 1e3 + base * 1e3
     step_mm = patch.spacing * 1e3
-    ys, xs = np.meshgrid(np.arange(ny + 1) * step_mm, np.arange(nx + 1) * step_mm, indexing="ij")
+    ys, xs = np.meshgrid(rows * step_mm, cols * step_mm, indexing="ij")
     top = np.column_stack([xs.ravel(), ys.ravel(), z_mm.ravel()])
     idx = np.arange(top.shape[0]).reshape(ny + 1, nx + 1)
     v00, v10 = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()
@@ -306,6 +352,8 @@ def export_design(
     base: float = 1e-3,
     source: str | None = None,
     z_step: float | None = None,
+    flank_step: int = FLANK_STEP,
+    force: bool = False,
 ) -> dict[str, Any]:
     """Write the design's surface to ``out`` (and ``out.json``); returns the sidecar record.
 
@@ -314,6 +362,9 @@ def export_design(
     thickness [m]; source: the design file name, for the record; z_step: a printer's layer
     height [units of R]: the asperities' height offsets are snapped to its multiples first
     (the largest shift is recorded; a design made with the same z_step moves by 0).
+    flank_step: STL only, mesh the flanks between contact zones on every flank_step-th grid
+    line (1: all). force: write a file over LARGE_FILE_BYTES; without it such an export
+    raises an error stating the size and how to make it smaller, writing nothing.
     """
     out = Path(out)
     snap = None
@@ -325,6 +376,9 @@ def export_design(
     patch = height_patch(design, radius=radius, tiles=tiles, grid=grid)
     if not np.isfinite(patch.heights).all() or not np.isfinite(patch.spacing) or patch.spacing <= 0:
         raise MetainterfaceError("the height map is not finite; check --radius and the heights")
+    expected = file_bytes(patch, fmt, flank_step)
+    if expected > LARGE_FILE_BYTES and not force:
+        raise MetainterfaceError(_too_large(patch, fmt, flank_step, expected))
     size = patch.size
     record: dict[str, Any] = {
         "file": out.name,
@@ -337,6 +391,8 @@ def export_design(
         "cell_side_m": patch.cell_side,
         "size_m": [size[0], size[1]],
         "layout": "row i at y = i * pixel_size_m, column j at x = j * pixel_size_m; tips up",
+        "cells": patch.tiles[0] * patch.tiles[1],
+        "one_cell": f"{patch.cell_side * 1e3:.4g} mm square, {patch.n_side**2} asperities",
     }
     if snap is not None:
         record["z_step"] = snap
@@ -352,7 +408,8 @@ def export_design(
         data = (_png_bytes if fmt == "png" else _tiff_bytes)(levels, patch.spacing, note)
         write_bytes(out, data)
     else:
-        mesh = patch_mesh(patch, base)
+        mesh = patch_mesh(patch, base, flank_step)
+        record["flank_step"] = int(flank_step)
         write_bytes(out, _stl_bytes(mesh))
         extents = [float(v) for v in mesh.extents]
         record.update(
@@ -378,6 +435,33 @@ def export_design(
     )
     write_text(sidecar_path(out), strict_json.dumps(record, indent=2) + "\n")
     return record
+
+
+def _mb(n: float) -> str:
+    return f"{n / 1e6:.3g} MB"
+
+
+def _too_large(patch: Patch, fmt: str, flank_step: int, size: int) -> str:
+    """One line: the file's size, and what would make it smaller."""
+    tiles = f"{patch.tiles[0]}x{patch.tiles[1]} cells"
+    ways = ["a lower --resolution"]
+    if fmt == "stl":
+        lx, ly = mesh_lines(patch, flank_step)
+        what = f"a {_mb(size)} STL ({stl_triangles(lx.size, ly.size) / 1e6:.3g} M triangles)"
+        ways.append(f"a larger --flank-step (now {flank_step})")
+        ways.append(
+            f"a 16-bit PNG height map (--format png, at most {_mb(file_bytes(patch, 'png'))})"
+        )
+    else:
+        what = f"a {_mb(size)} {fmt.upper()}"
+        if fmt == "npy":
+            ways.append(f"a 16-bit PNG (--format png, at most {_mb(file_bytes(patch, 'png'))})")
+    if patch.tiles != (1, 1):
+        ways.append("fewer --tiles (the cells repeat: one cell can be tiled by the printer)")
+    return (
+        f"{tiles} would make {what}, above {_mb(LARGE_FILE_BYTES)}: make it smaller with "
+        f"{', '.join(ways)}; or give --force (force=True) to write it"
+    )
 
 
 def _snap(design: Design, step: float, radius: float) -> tuple[Design, dict[str, Any]]:

@@ -38,7 +38,7 @@ class FrictionLaw:
     """A friction curve in newtons, rows in strictly increasing normal force.
 
     normal_force, friction_force: (K,) [N]. rows: (K,) 1-based data rows of the source file
-    (0 marks the origin added by :func:`friction_target`). source: file name for messages.
+    (0 marks the origin added by ``friction_target``). source: file name for messages.
     """
 
     normal_force: np.ndarray

@@ -239,6 +239,11 @@ class Design:
         return int(self.gamma.size)
 
     @property
+    def delta_max(self) -> float:
+        """Delta_max, the largest global indentation [length, units of R] (the settings')."""
+        return self.settings.delta_max
+
+    @property
     def idle(self) -> np.ndarray:
         """Indices of the asperities that never touch: more than Delta_max above the lowest."""
         return np.flatnonzero(self.h - self.h.min() > self.settings.delta_max * (1 + 1e-12))

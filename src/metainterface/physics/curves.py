@@ -285,6 +285,64 @@ def relative_l2(values: Tensor, reference: Tensor) -> Tensor:
     )
 
 
+def coverage(p_star: Tensor, p_reach: Tensor) -> Tensor:
+    """The fraction of a target's load range that a design reaches: (B, M), (B,) -> (B,).
+
+    p_star: the target's pressures (ascending, from 0 or near it); p_reach: the design's
+    largest pressure P*_max. P*_max / p_last clipped to [0, 1]: the load range is counted
+    from zero load, 1 when the design reaches the target's largest load.
+    """
+    return (p_reach / p_star[..., -1]).clamp(0.0, 1.0)
+
+
+def idle_mask(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_limit: Tensor | None = None,
+    *,
+    sweep_fn: Callable[..., Sweep] | None = None,
+) -> Tensor:
+    """(B, N) bool: the asperities that carry no load, for (B, N) designs.
+
+    Idle: anchored more than Delta_max above the lowest tip (never touches), or, with
+    p_limit (B,) a target's largest pressure, touching only at a load P* >= p_limit (past
+    the target's range). The load at each engagement (Delta = its anchored height) comes
+    from ``sweep_fn`` (default :func:`sweep`, the independent model).
+    """
+    hh = anchor(h)
+    idle = hh > settings.delta_max * (1 + 1e-12)
+    if p_limit is None:
+        return idle
+    with torch.no_grad():
+        sw = (sweep_fn or sweep)(gamma, h, settings, delta=hh.clamp(max=settings.delta_max))
+    return idle | (sw.p_star >= p_limit[:, None])
+
+
+def curve_error(alpha: Tensor, reference: Tensor, p_star: Tensor, p_reach: Tensor) -> Tensor:
+    """The package's one curve error: sqrt(fit^2 + (1 - coverage)^2), (B, M) x3, (B,) -> (B,).
+
+    fit = ||alpha - alpha_t||_2 / ||alpha_t||_2 over the target's pressures p_star that the
+    design reaches (p <= p_reach, its P*_max; 0 when none with alpha_t > 0 is reached);
+    coverage = :func:`coverage`. A design that meets the whole target scores its plain
+    relative L2 error; one that stops short is charged the load range it misses, whatever
+    its curve does beyond its reach (the convention of docs/concepts/errors.md).
+    Accepts numpy arrays too (then returns numpy).
+    """
+    as_numpy = not isinstance(alpha, Tensor)
+    if as_numpy:
+        alpha, reference, p_star, p_reach = (
+            torch.as_tensor(np.asarray(v, dtype=np.float64))
+            for v in (alpha, reference, p_star, p_reach)
+        )
+    reached = p_star <= p_reach[..., None]
+    num = torch.linalg.vector_norm(torch.where(reached, alpha - reference, 0.0), dim=-1)
+    den = torch.linalg.vector_norm(torch.where(reached, reference, 0.0), dim=-1)
+    fit = torch.where(den > 0, num / torch.where(den > 0, den, 1.0), 0.0)
+    err = torch.sqrt(fit**2 + (1.0 - coverage(p_star, p_reach)) ** 2)
+    return err.numpy() if as_numpy else err
+
+
 def to_grid(sw: Sweep, n_steps: int) -> Curve:
     """Resample a sweep onto n_steps uniform pressures on [0, P*_max] of each design.
 

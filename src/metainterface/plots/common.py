@@ -79,7 +79,9 @@ def tidy_axis(ax: Axes, *, x: bool = True, y: bool = True, bins: int = 5) -> Non
         axis.set_major_locator(MaxNLocator(bins))
         top = max(abs(lim[0]), abs(lim[1]))
         power = math.floor(math.log10(top)) if top > 0 and math.isfinite(top) else 0
-        if -2 <= power <= 3:
+        # side by side on an x axis, plain labels from 10^-2 down need 4+ decimals
+        # ('0.0025') and run together; stacked on a y axis they do not
+        if (-1 if axis is ax.xaxis else -2) <= power <= 3:
             fmt = ScalarFormatter(useOffset=False)
             fmt.set_scientific(False)
             axis.set_major_formatter(fmt)

@@ -97,14 +97,25 @@ def plot_design(result, curve, *, width: float | None = None) -> Figure:
     ax_p = fig.add_subplot(spots[-2])
     ax_c = fig.add_subplot(spots[-1])
     what = f"{result.method} design, error {percent(result.error)}"
+    coverage = getattr(result, "coverage", 1.0)
+    if coverage < 0.999:
+        what += f", coverage {percent(coverage)}"
     name = short(t.name, max(16, min(40, int(5 * width))))
     one_line = len(name) + len(what) + 2 <= min(60, 9 * width)
-    fig.suptitle(f"{name}: {what}" if one_line else f"{name}\n{what}", fontsize=11)
+    title = f"{name}: {what}" if one_line else f"{name}\n{what}"
+    if getattr(result, "forced", False):
+        title += "\nFORCED: the law is out of reach; the closest cell"
+    fig.suptitle(title, fontsize=11)
 
     keep = _every(t.p_star.size)
     p_top = 1.03 * max(t.p_star_max, float(curve.p_star[-1]))
     ax_a.plot(t.p_star[keep], t.alpha[keep], "k-", lw=2, label="target")
     ax_a.plot(curve.p_star, curve.alpha, "--", color="C0", label="design")
+    p_stop = float(curve.p_star[-1])
+    stops = p_stop < 0.999 * t.p_star_max  # the design ends inside the target's range
+    if stops:
+        for ax in (ax_a, ax_s):
+            ax.axvline(p_stop, color="C3", ls=":", lw=1.2, label="design stops")
     ax_a.set(xlabel=r"$P^* = P/E^*$", ylabel=r"$\alpha = A/A_{nom}$", title="contact area")
     ax_a.set_xlim(0, p_top)
     ax_a.set_ylim(bottom=0)
@@ -132,15 +143,17 @@ def plot_design(result, curve, *, width: float | None = None) -> Figure:
         tidy_axis(ax)
 
     if units:
-        _friction_panels(ax_f, ax_m, t, curve, units)
+        _friction_panels(ax_f, ax_m, t, curve, units, stops)
     _parameters(ax_p, result.design)
-    labels = _topography(fig, ax_c, result.design)
+    idle = getattr(result, "idle", tuple(int(i) for i in result.design.idle))
+    labels = _topography(fig, ax_c, result.design, idle)
     _fit_labels(fig, ax_c, labels, result.design.settings.n_side)
     return fig
 
 
-def _friction_panels(ax_f, ax_m, target, curve, units: dict) -> None:
-    """Friction force and coefficient against the normal force, in the user's newtons."""
+def _friction_panels(ax_f, ax_m, target, curve, units: dict, stops: bool = False) -> None:
+    """Friction force and coefficient against the normal force, in the user's newtons; with
+    ``stops``, where the design's load range ends is marked (in the same unit)."""
     tau, e_star, area = units["tau"], units["e_star"], units["area"]
     fn_d, ff_d = curve.p_star * area * e_star, curve.alpha * tau * area
     fn_t = units["normal"] if units["normal"].size else target.p_star * area * e_star
@@ -160,9 +173,23 @@ def _friction_panels(ax_f, ax_m, target, curve, units: dict) -> None:
     mu_d = ff_d[loaded_d] / fn_d[loaded_d]
     ax_m.plot(fn_t[loaded_t] / scale, mu_t, style, ms=4, label="friction law")
     ax_m.plot(fn_d[loaded_d] / scale, mu_d, "--", color="C0", label="design")
-    # mu grows without bound as the load goes to 0 (alpha ~ P*^(2/gamma+...)): keep the
-    # law's range in view instead of the design's first samples.
-    top = 1.5 * float(mu_t.max()) if mu_t.size else float(np.nanmax(mu_d))
+    if stops:
+        f_stop = float(fn_d[-1])
+        for ax in (ax_f, ax_m):
+            ax.axvline(
+                f_stop / scale,
+                color="C3",
+                ls=":",
+                lw=1.2,
+                label=f"design stops, {f_stop / scale:.3g} {unit}",
+            )
+    # mu grows without bound as the load goes to 0 (alpha ~ P*^(2/(gamma + 1))): the
+    # design's mu is kept in view from a tenth of its load range on, with the law's whole.
+    later = fn_d[loaded_d] >= 0.1 * fn_d.max()
+    tops = [1.5 * float(mu_t.max())] if mu_t.size else []
+    if later.any():
+        tops.append(1.15 * float(mu_d[later].max()))
+    top = max(tops) if tops else 1.0
     ax_m.set(
         xlabel=f"normal force [{unit}]",
         ylabel=r"friction coefficient $\mu$",
@@ -192,9 +219,10 @@ def _parameters(ax, design) -> None:
     ax_h.set_ylim(0, 1.3 * h_top if h_top > 0 else 1.0)
 
 
-def _topography(fig, ax, design) -> list:
+def _topography(fig, ax, design, idle: Sequence[int] = ()) -> list:
     """The cell's height map seen from above (colour bar in units of Delta_max), the contact
-    discs at Delta_max outlined, each asperity labelled with k, gamma and h."""
+    discs at Delta_max outlined, each asperity labelled with k, gamma and h; the ``idle``
+    ones (carrying no load) crossed out in red and labelled so."""
     from matplotlib.patches import Circle
 
     from metainterface.physics.sneddon import contact_radius
@@ -225,23 +253,29 @@ def _topography(fig, ax, design) -> list:
         if r > 0:
             ax.add_patch(Circle((x, y), r, fill=False, color="w", lw=1.0))
     labels = []
+    idle = set(idle)
     for k, ((x, y), g, hk) in enumerate(zip(centres, design.gamma, h0, strict=True)):
         full = f"k = {k}\n$\\gamma$ = {g:.2f}\nh = {_height(hk)} $\\Delta_{{max}}$"
+        if k in idle:
+            full = f"k = {k} idle\n$\\gamma$ = {g:.2f}\nh = {_height(hk)} $\\Delta_{{max}}$"
+            ax.plot([x], [y], "x", color="C3", ms=10, mew=2)
         text = ax.text(
             x,
             y - 0.5 * side / n * 0.92,
             full,
             ha="center",
             va="bottom",
-            color="k",
+            color="C3" if k in idle else "k",
             bbox={"boxstyle": "round,pad=0.15", "fc": "w", "ec": "none", "alpha": 0.75},
         )
-        labels.append((text, str(k)))
+        labels.append((text, f"{k}x" if k in idle else str(k)))
     ax.set(
         xlim=(0, side),
         ylim=(0, side),
         aspect="equal",
-        title="cell from above\n" + r"white: contact at $\Delta_{max}$",
+        title="cell from above\n"
+        + r"white: contact at $\Delta_{max}$"
+        + (", red x: idle" if idle else ""),
         xlabel="x / R",
         ylabel="y / R",
     )

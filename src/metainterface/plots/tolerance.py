@@ -51,7 +51,11 @@ def plot_tolerance(result) -> Figure:
         t = result.reference
         ax.plot(t.p_star, t.alpha, "k--", lw=1, label=f"target {t.name}")
     ax.set(xlabel=r"$P^* = P/E^*$", ylabel=r"$\alpha = A/A_{nom}$")
-    ax.set_xlim(0, float(p[-1]))
+    # the limits hold the design and its target; where the design stops short, marked
+    p_ref = float(result.reference.p_star[-1]) if result.reference is not None else 0.0
+    ax.set_xlim(0, max(float(p[-1]), p_ref))
+    if p_ref > 1.001 * float(p[-1]):
+        ax.axvline(float(p[-1]), color="C3", ls=":", lw=1.2, label="design stops")
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 3))
@@ -77,7 +81,7 @@ def plot_tolerance(result) -> Figure:
         ax_e.axvline(100 * value, color="C1", ls=style, label=f"{label} {100 * value:.3g} %")
     if result.error_nominal > 0:
         ax_e.axvline(100 * result.error_nominal, color="C3", label="nominal design")
-    ax_e.set(xlabel=f"relative curve error to the {s.reference} [%]", ylabel="made cells")
+    ax_e.set(xlabel=f"curve error to the {s.reference} [%]", ylabel="made cells")
     ax_e.grid(alpha=0.3)
     ax_e.legend(fontsize=7)
 
@@ -109,7 +113,9 @@ def plot_tolerance(result) -> Figure:
             ylabel=f"friction stress $\\tau\\,\\alpha$ [{fu}]",
             title="friction law (Bowden-Tabor)",
         )
-        ax_f.set_xlim(0, float(pressure[-1] / ps))
+        ax_f.set_xlim(0, max(float(pressure[-1]), p_ref * result.modulus) / ps)
+        if p_ref > 1.001 * float(p[-1]):
+            ax_f.axvline(float(pressure[-1] / ps), color="C3", ls=":", lw=1.2, label="design stops")
         ax_f.set_ylim(bottom=0)
         ax_f.grid(alpha=0.3)
         ax_f.legend(fontsize=7, loc="lower right")

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import torch
 
 from metainterface import _checks
 from metainterface._names import DEFAULT_ENGINE
@@ -143,36 +144,56 @@ class ValidationResult:
         return float(np.abs(self.alpha_bem_pixels / self.alpha_model - 1.0)[self.upper_half].max())
 
     def target_error(self, alpha: np.ndarray) -> float | None:
-        """Relative curve error of alpha (K,), at this result's loads, against the design's
-        target, or None.
+        """The package's curve error (``physics.curves.curve_error``) of
+        alpha (K,), measured at this result's loads, against the design's target; or None
+        without a target.
 
-        ||alpha - alpha_target||_2 / ||alpha_target||_2 over the loads within the target's
-        pressure range (the target interpolated there). None without a target or with no
-        load inside its range.
+        Measured as ``design`` measures: on the target's uniform grid of ``ERROR_POINTS``
+        pressures, with the model's exact alpha there times alpha / alpha_model interpolated
+        between the loads (so the model's own alpha scores exactly the model's design
+        error, and the BEM's differs only by the measured ratio); coverage is the load
+        path's P*_max (the design's) over the target's largest load.
         """
         target = design_target(self.design)
         if target is None:
             return None
-        p_t, a_t = target
-        inside = (self.p_star >= p_t[0]) & (self.p_star <= p_t[-1] * (1 + 1e-9))
-        if not inside.any():
-            return None
-        ref = np.interp(self.p_star[inside], p_t, a_t)
-        norm = float(np.linalg.norm(ref))
-        if norm == 0.0:
-            return None
-        return float(np.linalg.norm(alpha[inside] - ref)) / norm
+        return _grid_error(self.design, self.model, target, self.p_star, alpha / self.alpha_model)
 
     def target_errors(self) -> tuple[float, float] | None:
         """``target_error`` of BEM and model: (BEM, model), or None.
 
         The BEM figure is what the manufactured surface would show; the model one is the
-        design's own claim, at the same loads.
+        design's own claim, the same figure ``design`` reported with this model.
         """
         bem = self.target_error(self.alpha_bem)
         if bem is None:
             return None
         return bem, self.target_error(self.alpha_model)  # type: ignore[return-value]
+
+    @property
+    def coverage(self) -> float | None:
+        """The fraction of the target's load range the design reaches (None: no target)."""
+        target = design_target(self.design)
+        if target is None:
+            return None
+        return float(min(1.0, self.p_star[-1] / target[0][-1]))
+
+    @property
+    def idle(self) -> tuple[int, ...]:
+        """Indices of the asperities that carry no load within Delta_max and the target's
+        load range."""
+        from metainterface.physics.curves import idle_mask
+
+        gamma, h = self.design.tensors(torch.float64)
+        target = design_target(self.design)
+        limit = None if target is None else torch.tensor([target[0][-1]], dtype=torch.float64)
+        mask = idle_mask(gamma, h, self.design.settings, limit, sweep_fn=self.model.sweep)
+        return tuple(int(i) for i in np.flatnonzero(mask[0].numpy()))
+
+    @property
+    def carrying(self) -> int:
+        """The number of load-carrying asperities."""
+        return self.design.n_asperities - len(self.idle)
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (with the target errors if the design carries a target)."""
@@ -182,6 +203,9 @@ class ValidationResult:
             if errors is None
             else {"target_error_bem": errors[0], "target_error_model": errors[1]}
         )
+        if errors is not None:
+            extra["coverage"] = self.coverage
+        extra["carrying_asperities"] = self.carrying
         return {
             "name": self.name,
             "engine": self.engine,
@@ -229,6 +253,34 @@ def resolve_loads(loads: int | Sequence[float] | np.ndarray, p_star_max: float) 
             f"(P*_max = {p_star_max:.6g}); allowed range (0, {p_star_max:.6g}]"
         )
     return np.minimum(values, p_star_max)
+
+
+#: Points of the uniform grid every curve error is measured on (RefineSettings.grid_points).
+ERROR_POINTS = 128
+
+
+def _grid_error(
+    design: Design,
+    model: ForwardModel,
+    target: tuple[np.ndarray, np.ndarray],
+    loads: np.ndarray,
+    ratio: np.ndarray,
+) -> float:
+    """curve_error on the target's ERROR_POINTS grid of the model's exact alpha times
+    ``ratio`` (K,) interpolated in the ``loads`` (K,), held at the ends."""
+    from metainterface.physics.curves import curve_error
+
+    p_t, a_t = target
+    grid = np.linspace(0.0, float(p_t[-1]), ERROR_POINTS)
+    ref = np.interp(grid, p_t, a_t, left=0.0)
+    gamma, h = design.tensors(torch.float64)
+    with torch.no_grad():
+        alpha, p_max = model.alpha_at(
+            gamma, h, design.settings, torch.as_tensor(grid)[None], exact=True
+        )
+    scale = np.interp(grid, loads, np.nan_to_num(ratio, nan=1.0, posinf=1.0))
+    err = curve_error(alpha.numpy() * scale, ref[None], grid[None], p_max.numpy())
+    return float(err[0])
 
 
 def design_target(design: Design) -> tuple[np.ndarray, np.ndarray] | None:
