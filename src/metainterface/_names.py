@@ -15,3 +15,5 @@ DEFAULT_MODEL = "independent"
 METHOD_NAMES: tuple[str, ...] = ("surrogate", "multistart", "hertz")
 #: The export formats (``io.export.FORMATS``).
 EXPORT_FORMATS: tuple[str, ...] = ("stl", "png", "tiff", "npy")
+#: When a friction law's rows are replaced by a monotone fit (``physical.friction.FIT_CHOICES``).
+FIT_NAMES: tuple[str, ...] = ("auto", "always", "never")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from metainterface._names import DEFAULT_MODEL, METHOD_NAMES, MODEL_NAMES
+from metainterface._names import DEFAULT_MODEL, FIT_NAMES, METHOD_NAMES, MODEL_NAMES
 from metainterface.cli.common import positive_int
 
 
@@ -36,6 +36,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="FILE",
         help="CSV normal_force,friction_force [N] (or normal_force,friction_coefficient)"
         "; needs --shear-strength --modulus --radius --area",
+    )
+    src.add_argument(
+        "--fit",
+        choices=FIT_NAMES,
+        default="auto",
+        help="replace the friction rows by a monotone smooth fit (a cubic spline, knots by "
+        "cross-validation): auto (default) fits rows with scatter, repeated or unsorted loads, "
+        "or 5-9 rows; the fit is drawn in friction_fit.png",
     )
     phys = p.add_argument_group("physical units (with --friction-csv, or for a physical block)")
     phys.add_argument("--shear-strength", help="interface shear strength tau, e.g. 0.25MPa")
@@ -151,8 +159,12 @@ def _targets(args: argparse.Namespace) -> list:
                 modulus=args.modulus,
                 radius=args.radius,
                 area=args.area,
+                fit=args.fit,
             )
         )
+        fit = targets[-1].meta["friction"].get("fit")
+        if fit is not None:
+            print(f"{targets[-1].name}: {fit['summary']}")
     if not targets:
         raise mi.MetainterfaceError("give at least one --target, --target-csv or --friction-csv")
     return targets
