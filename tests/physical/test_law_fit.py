@@ -22,8 +22,8 @@ def _noisy(k, noise, seed=0):
 
 @pytest.mark.parametrize(("k", "noise", "tol"), [(40, 0.03, 0.03), (8, 0.03, 0.06), (5, 0.0, 0.03)])
 def test_fit_recovers_a_known_law_from_noisy_unsorted_samples(k, noise, tol):
-    # tolerance: the largest error over the loads measured, relative to the largest friction (~3 N); for
-    # 1 % noise and 40 points a few times noise / sqrt(points per knot)
+    # tolerance: the largest error over the loads measured, relative to the largest
+    # friction (~3 N); with 1 % noise a few times noise / sqrt(points per knot)
     fn, ff = _noisy(k, noise)
     fit = fit_law(fn, ff)
     grid = np.linspace(0.0, fn.max(), 200)  # the fit covers the loads measured
@@ -53,7 +53,7 @@ def test_auto_fits_measured_rows_and_keeps_a_clean_law():
     clean = FrictionLaw(clean_fn, saturating(clean_fn), rows=np.arange(1, 21), source="clean")
     kept, none = prepare_law(clean, "auto")
     assert none is None and kept is clean
-    with pytest.raises(MetainterfaceError, match="cannot decrease|not above"):
+    with pytest.raises(MetainterfaceError, match=r"cannot decrease|not above"):
         prepare_law(law, "never")
     with pytest.raises(MetainterfaceError, match="fit must be one of"):
         prepare_law(law, "sometimes")
