@@ -19,6 +19,8 @@ Targets and designs
     Target, Design, CellSettings
 Designing
     design, compare, DesignResult, pressure_check, physical
+    feasible_scale (which area, E* or tau makes a friction law reachable, FeasibleScale),
+    design_scale (a friction law designed with its area, E* or tau chosen too)
 Curves and forward models
     curve, Curve, ForwardModel, Independent, Interacting, MODELS, get_model, register_model
 Checking and making
@@ -76,6 +78,8 @@ _HOMES: dict[str, str] = {
     "validate_many": "metainterface.api",
     "view": "metainterface.api",
     "write_result": "metainterface.api",
+    "design_scale": "metainterface.api.scale",
+    "feasible_scale": "metainterface.api.scale",
     "MetainterfaceError": "metainterface.errors",
     "Target": "metainterface.inverse.targets",
     "CellSettings": "metainterface.physics.cell",
@@ -89,6 +93,7 @@ _HOMES: dict[str, str] = {
     "tune_allocator": "metainterface.runtime",
     "TrainConfig": "metainterface.surrogate.train",
     "ValidationResult": "metainterface.validation.validate",
+    "FeasibleScale": "metainterface.inverse.scale",
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
@@ -113,7 +118,9 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         view,
         write_result,
     )
+    from metainterface.api.scale import design_scale, feasible_scale
     from metainterface.errors import MetainterfaceError
+    from metainterface.inverse.scale import FeasibleScale
     from metainterface.inverse.targets import Target
     from metainterface.physics.cell import CellSettings, Design
     from metainterface.physics.models import (
@@ -167,6 +174,7 @@ __all__ = [
     "Curve",
     "Design",
     "DesignResult",
+    "FeasibleScale",
     "ForwardModel",
     "Independent",
     "Interacting",
@@ -180,8 +188,10 @@ __all__ = [
     "compare",
     "curve",
     "design",
+    "design_scale",
     "evaluate_surrogate",
     "export",
+    "feasible_scale",
     "generate_dataset",
     "get_model",
     "min_radius",
