@@ -44,10 +44,6 @@ def write_design_outputs(
     if isinstance(friction, dict) and "fit" in friction:  # the measured rows were fitted
         from metainterface.plots.lawfit import plot_friction_fit
 
-        fit = {
-            **friction["fit"],
-            "law_normal_force_n": friction["normal_force_n"],
-            "law_friction_force_n": friction["friction_force_n"],
-        }
-        save_figure(plot_friction_fit(fit, t.name), folder / "friction_fit.png", target=t.name)
+        fig = plot_friction_fit(friction, t.name)
+        save_figure(fig, folder / "friction_fit.png", target=t.name)
     return result.design.save(folder / "design.json", **record, **extra)

@@ -139,8 +139,8 @@ _NAMES = {"area": "an area", "modulus": "E*", "shear_strength": "tau"}
 
 def fmt_area(a: float) -> str:
     """An area [m^2] in mm^2, cm^2 or m^2, three significant digits."""
-    for unit, f in (("m^2", 1.0), ("cm^2", 1e-4), ("mm^2", 1e-6)):
-        if a >= f or unit == "mm^2":
+    for unit, f, at in (("m^2", 1.0, 0.1), ("cm^2", 1e-4, 1e-4), ("mm^2", 1e-6, 0.0)):
+        if a >= at:
             return f"{a / f:.3g} {unit}"
     raise AssertionError  # pragma: no cover
 
@@ -168,6 +168,21 @@ def _runs(ok: np.ndarray) -> list[tuple[int, int]]:
     """Index ranges [i, j] of the True runs in a boolean row."""
     edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
     return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+#: Feasible ranges closer than this ratio are reported as one: the envelope is an estimate
+#: from a finite family of cells, and a gap of a grid step or two is its noise.
+MERGE_RATIO = 1.15
+
+
+def _merged(runs: list[tuple[int, int]], values: np.ndarray) -> list[tuple[int, int]]:
+    out: list[tuple[int, int]] = []
+    for i, j in runs:
+        if out and values[i] / values[out[-1][1]] < MERGE_RATIO:
+            out[-1] = (out[-1][0], j)
+        else:
+            out.append((i, j))
+    return out
 
 
 def scan(
@@ -233,7 +248,7 @@ def feasible_scale(
             ranges[var], best[var], best_out[var] = [], lo, int(p0.size)
             continue
         values, v, out = scan(p0, a0, var, given[var], (lo, hi), s)
-        runs = _runs(out == 0)
+        runs = _merged(_runs(out == 0), values)
         ranges[var] = [(float(values[i]), float(values[j])) for i, j in runs]
         if runs:  # the middle (in log) of the widest range: the most room either side
             i, j = max(runs, key=lambda r: r[1] - r[0])

@@ -10,16 +10,17 @@ from matplotlib.figure import Figure
 from metainterface.plots.common import new_figure, short, tidy_axis
 
 
-def plot_friction_fit(fit: dict[str, Any], name: str = "friction law") -> Figure:
-    """The law fit recorded in a target's ``meta["friction"]["fit"]`` (raw forces [N]) with
-    the fitted law ``normal_force_n``/``friction_force_n`` of ``meta["friction"]``: left the
-    data and the fit, right the residuals data - fit."""
+def plot_friction_fit(friction: dict[str, Any], name: str = "friction law") -> Figure:
+    """A fitted friction law: ``friction`` is a target's ``meta["friction"]`` (the law
+    ``normal_force_n``, ``friction_force_n`` [N] and its ``fit``, with the raw rows). Left
+    the measured rows and the fit, right the residuals data - fit."""
+    fit = friction["fit"]
     fig = new_figure(9.0, 3.4)
     ax, res = fig.subplots(1, 2, width_ratios=(3, 2))
     fn = np.asarray(fit["raw_normal_force_n"])
     ff = np.asarray(fit["raw_friction_force_n"])
-    law_fn = np.asarray(fit["law_normal_force_n"])
-    law_ff = np.asarray(fit["law_friction_force_n"])
+    law_fn = np.asarray(friction["normal_force_n"])
+    law_ff = np.asarray(friction["friction_force_n"])
     ax.plot(fn, ff, "o", ms=4, color="0.45", label=f"measured ({fn.size} rows)")
     ax.plot(law_fn, law_ff, "-", color="C0", lw=2, label="monotone fit")
     ax.set_xlabel("normal force $F_n$ (N)")
