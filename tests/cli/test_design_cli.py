@@ -135,6 +135,13 @@ def test_design_cli_area_auto_and_fit(tmp_path, capsys):
     assert scale["variable"] == "area"
     assert data["physical"]["area_m2"] == pytest.approx(scale["value"])
     assert (out / "friction_fit.png").exists()
+    # the export tiles the area chosen
+    npy = tmp_path / "patch.npy"
+    args = ["export", str(out / "design.json"), "--radius", "0.5mm", "--tiles", "auto"]
+    assert main([*args, "--resolution", "8", "--out", str(npy)]) == 0
+    n = data["physical"]["tiles_per_side"]
+    assert json.loads((tmp_path / "patch.npy.json").read_text())["tiles"] == [n, n]
+    capsys.readouterr()
     fixed = tmp_path / "fixed"
     assert main([*base, "--area", "1000cm2", "--out", str(fixed)]) == 0
     text = capsys.readouterr().out

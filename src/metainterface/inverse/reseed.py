@@ -7,9 +7,12 @@ over the law: it is printed but carries nothing, and its place on the cell is wa
 loss cannot bring it back by itself (its gradient is zero while it does not touch). Such a
 design gets ``RESEED_STARTS`` new starts: the idle asperities moved to random heights
 within Delta_L of the lowest tip and given random shape exponents, the others as designed;
-they are refined like any start, and the best replaces the design when its error is no
-worse than the design's by more than ``RESEED_SLACK`` (relative) or ``RESEED_FLOOR``
-(absolute): a cell whose every asperity carries load is worth a hair of curve error.
+they are refined like any start, and the best of those that leave fewer asperities idle
+replaces the design when its error is no worse than the design's by more than
+``RESEED_SLACK`` (relative) or ``RESEED_FLOOR`` (absolute): a cell whose asperities carry
+load is worth a hair of curve error. Where none is good enough (a law that only a few
+sharp asperities can follow), the design stays as it is and its idle asperities are
+reported.
 """
 
 from __future__ import annotations
@@ -97,7 +100,9 @@ def reseed(
     g1, h1 = FULL.to_design(raw.detach(), s)
     err = relative_error(g1, h1, s, grid, model).view(len(todo), k)
     still, _ = idle_in_range(g1, h1, s, p_max[rows], model)
-    err = torch.where(still.any(-1).view(len(todo), k), torch.inf, err)  # must use them all
+    left = still.sum(-1).view(len(todo), k)
+    fewer = left < idle[todo].sum(-1, keepdim=True)
+    err = torch.where(fewer, err, torch.inf)  # it must put at least one of them to use
     out = list(results)
     for j, i in enumerate(todo):
         b = int(err[j].argmin())
@@ -107,8 +112,8 @@ def reseed(
             row = j * k + b
             note = (
                 f"target {r.target.name}: {_count(int(idle[i].sum()))} that never touched "
-                f"over the target's range were re-seeded and now carry load (error "
-                f"{100 * r.error:.3g} % -> {100 * e:.3g} %)"
+                f"over the target's range were re-seeded, {_count(int(left[j, b]))} idle "
+                f"now (error {100 * r.error:.3g} % -> {100 * e:.3g} %)"
             )
             out[i] = replace(
                 r,
