@@ -162,6 +162,25 @@ def _candidates(fs: _scale.FeasibleScale, var: str, count: int) -> np.ndarray:
     return np.clip(np.geomspace(b / 1.3, b * 1.3, count), lo_b, hi_b)
 
 
+def _closer(values: np.ndarray, errors: np.ndarray) -> np.ndarray:
+    """Second-round candidates: the geometric midpoints between the best value and its
+    neighbours, and the vertex of the parabola through the three in (log value, log error)
+    where it falls between them (a step of golden-section-like refinement, on a batch)."""
+    k = int(np.argmin(errors))
+    lo, hi = max(k - 1, 0), min(k + 1, values.size - 1)
+    x = np.log(values)
+    out = [float(np.exp(0.5 * (x[lo] + x[k]))), float(np.exp(0.5 * (x[k] + x[hi])))]
+    if 0 < k < values.size - 1:
+        y = np.log(np.maximum(errors[lo : hi + 1], 1e-12))
+        c = np.polyfit(x[lo : hi + 1], y, 2)
+        if c[0] > 0:
+            v = -c[1] / (2 * c[0])
+            if x[lo] < v < x[hi]:
+                out.append(float(np.exp(v)))
+    out = np.unique([v for v in out if not np.isclose(v, values, rtol=1e-3).any()])
+    return np.asarray(out, dtype=np.float64)
+
+
 def design_scale(
     law: str | os.PathLike[str] | Any,
     *,
@@ -180,8 +199,9 @@ def design_scale(
     One of area, modulus, shear_strength is 'auto' or a range ('2cm2..10cm2'; area defaults
     to 'auto'), the others fixed. The scales that make the law reachable are found
     (:func:`feasible_scale`); ``candidates`` values spread over them (or, where none is
-    reachable, around the closest) are each designed with a short refinement, in one batch;
-    the one with the smallest error is designed in full with ``options`` (as
+    reachable, around the closest) are each designed with a short refinement, in one batch,
+    then up to three more between the best and its neighbours (:func:`_closer`); the one
+    with the smallest error is designed in full with ``options`` (as
     :func:`~metainterface.design`, e.g. ``method``, ``seed``, ``out``).
 
     Returns the DesignResult; ``result.target.meta["scale"]`` holds the chosen value, the
@@ -236,14 +256,25 @@ def design_scale(
         )
 
     quick_opts = {k: v for k, v in options.items() if k in ("method", "seed", "model", "hedge")}
-    quick = design(
-        [target(v, f"{stem}-{i}") for i, v in enumerate(values)],
-        settings=settings,
-        refine_settings=QUICK,
-        fallback=0,
-        **quick_opts,
-    )
-    errors = np.array([r.error for r in quick])
+
+    def quick(vals: np.ndarray) -> np.ndarray:
+        made = design(
+            [target(v, f"{stem}-{i}") for i, v in enumerate(vals)],
+            settings=settings,
+            refine_settings=QUICK,
+            fallback=0,
+            **quick_opts,
+        )
+        return np.array([r.error for r in made])
+
+    errors = quick(values)
+    if values.size >= 3:  # a second round between the best and its neighbours
+        more = _closer(values, errors)
+        if more.size:
+            values = np.concatenate([values, more])
+            errors = np.concatenate([errors, quick(more)])
+            order = np.argsort(values)
+            values, errors = values[order], errors[order]
     k = int(np.argmin(errors))
     chosen = float(values[k])
     at = {**given, var: chosen}
