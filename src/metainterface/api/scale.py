@@ -200,7 +200,7 @@ def design_scale(
     to 'auto'), the others fixed. The scales that make the law reachable are found
     (:func:`feasible_scale`); ``candidates`` values spread over them (or, where none is
     reachable, around the closest) are each designed with a short refinement, in one batch,
-    then up to three more between the best and its neighbours (:func:`_closer`); the one
+    then up to three more between the best and its neighbours; the one
     with the smallest error is designed in full with ``options`` (as
     :func:`~metainterface.design`, e.g. ``method``, ``seed``, ``out``).
 
