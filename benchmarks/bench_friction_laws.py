@@ -119,11 +119,12 @@ def main() -> None:
         ("cell curves, with stiffness", with_s),
         ("cell curves, no stiffness", without_s),
     ]
-    refined, idle_designs = None, 0
+    refined, idle_designs, idle_total = None, 0, 0
     if args.refine:
         made = mi.design(targets)
         refined = np.array([r.error for r in made])
-        idle_designs = sum(idle_count(r) > 0 for r in made)
+        counts = [idle_count(r) for r in made]
+        idle_designs, idle_total = sum(c > 0 for c in counts), sum(counts)
     lines = [
         "| targets | n | median zero-shot | p90 zero-shot |",
         "| --- | ---: | ---: | ---: |",
@@ -138,7 +139,7 @@ def main() -> None:
         )
         lines.append(
             f"\n{idle_designs} of {refined.size} refined designs have an asperity that never "
-            "touches over the law's range"
+            f"touches over the law's range ({idle_total} such asperities in all)"
         )
     text = "\n".join(lines)
     print(text)
