@@ -162,6 +162,22 @@ def _candidates(fs: _scale.FeasibleScale, var: str, count: int) -> np.ndarray:
     return np.clip(np.geomspace(b / 1.3, b * 1.3, count), lo_b, hi_b)
 
 
+def uncovered(result: Any) -> float:
+    """The share of a target's pressure range its design does not reach by Delta_max.
+
+    The relative curve error holds a design's alpha at its last value past its reach, so a
+    design that stops short of the law can score well; the scale search adds this share to
+    the error, so that it prefers a scale whose design carries the whole law."""
+    import torch
+
+    g, h = result.design.tensors()
+    with torch.no_grad():
+        zero = torch.zeros(1, 1, dtype=g.dtype)
+        _, p_max = result.model.alpha_at(g, h, result.design.settings, zero)
+    top = float(result.target.p_star_max)
+    return max(0.0, 1.0 - float(p_max[0]) / top) if top > 0 else 0.0
+
+
 def _closer(values: np.ndarray, errors: np.ndarray) -> np.ndarray:
     """Second-round candidates: the geometric midpoints between the best value and its
     neighbours, and the vertex of the parabola through the three in (log value, log error)
@@ -204,8 +220,11 @@ def design_scale(
     with the smallest error is designed in full with ``options`` (as
     :func:`~metainterface.design`, e.g. ``method``, ``seed``, ``out``).
 
+    A candidate's score is its quick design's relative curve error plus the share of the
+    law's pressure range the design does not reach by Delta_max (:func:`uncovered`).
+
     Returns the DesignResult; ``result.target.meta["scale"]`` holds the chosen value, the
-    tiling it gives (cells and cells per side), the candidates' quick errors and the
+    tiling it gives (cells and cells per side), the candidates and their scores and the
     feasibility summary, and design.json records them.
     """
     from metainterface.api.functions import design
@@ -265,7 +284,7 @@ def design_scale(
             fallback=0,
             **quick_opts,
         )
-        return np.array([r.error for r in made])
+        return np.array([r.error + uncovered(r) for r in made])
 
     errors = quick(values)
     if values.size >= 3:  # a second round between the best and its neighbours
@@ -289,7 +308,7 @@ def design_scale(
                 "value": chosen,
                 "searched": list(fs.bounds[var]),
                 "candidates": [float(v) for v in values],
-                "candidate_errors": [float(e) for e in errors],
+                "candidate_scores": [float(e) for e in errors],
                 "n_cells": n_cells,
                 "tiles_per_side": per_side,
                 "feasibility": fs.record(),
