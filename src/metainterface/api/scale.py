@@ -221,7 +221,7 @@ def design_scale(
     :func:`~metainterface.design`, e.g. ``method``, ``seed``, ``out``).
 
     A candidate's score is its quick design's relative curve error plus the share of the
-    law's pressure range the design does not reach by Delta_max (:func:`uncovered`).
+    law's pressure range the design does not reach by Delta_max.
 
     Returns the DesignResult; ``result.target.meta["scale"]`` holds the chosen value, the
     tiling it gives (cells and cells per side), the candidates and their scores and the
