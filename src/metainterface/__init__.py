@@ -19,7 +19,9 @@ Targets and designs
     Target, Design, CellSettings
 Designing
     design, compare, DesignResult, pressure_check, physical, reachability (can a cell
-    follow this friction law at this E*, tau and area?), Reachability, UnreachableError
+    follow this friction law at this E*, tau and area?), Reachability, UnreachableError,
+    feasible_scale (which area, E* or tau makes a friction law reachable, FeasibleScale),
+    design_scale (a friction law designed with its area, E* or tau chosen too)
 Curves and forward models
     curve, Curve, ForwardModel, Independent, Interacting, MODELS, get_model, register_model
 Checking and making
@@ -77,6 +79,8 @@ _HOMES: dict[str, str] = {
     "validate_many": "metainterface.api",
     "view": "metainterface.api",
     "write_result": "metainterface.api",
+    "design_scale": "metainterface.api.scale",
+    "feasible_scale": "metainterface.api.scale",
     "MetainterfaceError": "metainterface.errors",
     "UnreachableError": "metainterface.errors",
     "Reachability": "metainterface.physical.reach",
@@ -93,6 +97,7 @@ _HOMES: dict[str, str] = {
     "tune_allocator": "metainterface.runtime",
     "TrainConfig": "metainterface.surrogate.train",
     "ValidationResult": "metainterface.validation.validate",
+    "FeasibleScale": "metainterface.inverse.scale",
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
@@ -119,6 +124,9 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     )
     from metainterface.api.reach import reachability
     from metainterface.errors import MetainterfaceError, UnreachableError
+    from metainterface.api.scale import design_scale, feasible_scale
+    from metainterface.errors import MetainterfaceError
+    from metainterface.inverse.scale import FeasibleScale
     from metainterface.inverse.targets import Target
     from metainterface.physical.reach import Reachability
     from metainterface.physics.cell import CellSettings, Design
@@ -173,6 +181,7 @@ __all__ = [
     "Curve",
     "Design",
     "DesignResult",
+    "FeasibleScale",
     "ForwardModel",
     "Independent",
     "Interacting",
@@ -188,8 +197,10 @@ __all__ = [
     "compare",
     "curve",
     "design",
+    "design_scale",
     "evaluate_surrogate",
     "export",
+    "feasible_scale",
     "generate_dataset",
     "get_model",
     "min_radius",

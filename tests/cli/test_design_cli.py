@@ -111,3 +111,41 @@ def test_compare_of_one_target_writes_into_out(tmp_path):
     assert main(["design", "--target", "linear", "--compare", "--out", str(out), *quick]) == 0
     assert {p.name for p in out.iterdir()} == {"surrogate", "multistart", "hertz", "compare.png"}
     assert (out / "hertz" / "design.json").is_file()
+
+
+def test_design_cli_area_auto_and_fit(tmp_path, capsys):
+    """--area auto designs the area with the cell and reports it; scattered rows are fitted
+    (friction_fit.png); a fixed area out of reach is answered with what to change."""
+    rng = np.random.default_rng(0)
+    loads = np.repeat(np.linspace(0.5, 8.0, 10), 2)
+    friction = 0.4 * loads**0.8 * (1 + 0.03 * rng.standard_normal(loads.size))
+    csv = tmp_path / "measured.csv"
+    csv.write_text(
+        "normal_force,friction_force\n"
+        + "\n".join(f"{n},{f}" for n, f in zip(loads[::-1], friction[::-1], strict=True))
+    )
+    base = ["design", "--friction-csv", str(csv), "--shear-strength", "0.25MPa"]
+    base += ["--modulus", "20MPa", "--radius", "0.5mm", "--refine", "none", "--fallback", "0"]
+    out = tmp_path / "auto"
+    assert main([*base, "--area", "auto", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "monotone cubic spline" in text and "chose area =" in text and "tiles" in text
+    data = json.loads((out / "design.json").read_text())
+    scale = data["target"]["scale"]
+    assert scale["variable"] == "area"
+    assert data["physical"]["area_m2"] == pytest.approx(scale["value"])
+    assert (out / "friction_fit.png").exists()
+    # the export tiles the area chosen
+    npy = tmp_path / "patch.npy"
+    args = ["export", str(out / "design.json"), "--radius", "0.5mm", "--tiles", "auto"]
+    assert main([*args, "--resolution", "8", "--out", str(npy)]) == 0
+    n = data["physical"]["tiles_per_side"]
+    assert json.loads((tmp_path / "patch.npy.json").read_text())["tiles"] == [n, n]
+    capsys.readouterr()
+    fixed = tmp_path / "fixed"
+    assert main([*base, "--area", "1000cm2", "--out", str(fixed)]) == 0
+    text = capsys.readouterr().out
+    assert "not reachable at area" in text
+    assert "reachable with" in text and "--area auto" in text
+    assert main([*base, "--area", "auto", "--target", "linear", "--out", str(fixed)]) == 2
+    assert "alone" in capsys.readouterr().err

@@ -599,8 +599,10 @@ def export(
         ``path.json`` records the height scale, grid and provenance.
     radius : str or float
         Asperity radius R ('0.5mm', or metres).
-    tiles : (nx, ny) or 'NXxNY'
-        Cells along x and y.
+    tiles : (nx, ny), 'NXxNY' or 'auto'
+        Cells along x and y; 'auto': the tiling design.json's physical block gives for the
+        area or total force designed for (a design.json path written with them, e.g. by
+        ``design_scale`` or ``metainterface design --area auto``).
     format : {"stl", "png", "tiff", "npy"}
     resolution : float
         Grid points per mm (default 64 per asperity pitch).
@@ -627,6 +629,8 @@ def export(
 
     check_output_file(path)
     d = _as_design(design, None, None, None)
+    if isinstance(tiles, str) and tiles.strip().lower() == "auto":
+        tiles = _designed_tiles(design)
     if resolution is not None:
         resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
     radius_m = parse_length(radius, option="radius")
@@ -674,6 +678,24 @@ def _cells_note(d: Design, tiles: Any) -> tuple[str, ...]:
         f"square, {d.n_asperities} asperities); the design's physical block covers its area "
         f"with {block['n_cells']:.3g} cells: --tiles {per_side}x{per_side} for the whole patch",
     )
+def _designed_tiles(design: Any) -> tuple[int, int]:
+    """(n, n) from the physical block of a design.json (tiles='auto')."""
+    import json
+
+    block = None
+    if isinstance(design, str | os.PathLike):
+        try:
+            block = json.loads(Path(design).read_text()).get("physical")
+        except (OSError, ValueError, AttributeError):
+            block = None
+    if not isinstance(block, dict) or "tiles_per_side" not in block:
+        raise MetainterfaceError(
+            "tiles='auto' needs a design.json whose physical block has the tiling (designed "
+            "with radius, modulus and an area or total force); give tiles as (nx, ny)",
+            argument="tiles",
+        )
+    n = int(block["tiles_per_side"])
+    return n, n
 
 
 def physical(

@@ -1,4 +1,5 @@
-"""What a design writes: design.json, curve.csv, design.png (and target.csv) in one folder."""
+"""What a design writes: design.json, curve.csv, design.png (and target.csv, and
+friction_fit.png for a fitted friction law) in one folder."""
 
 from __future__ import annotations
 
@@ -39,4 +40,10 @@ def write_design_outputs(
         target=t.name,
         method=result.method,
     )
+    friction = t.meta.get("friction") if isinstance(t.meta, dict) else None
+    if isinstance(friction, dict) and "fit" in friction:  # the measured rows were fitted
+        from metainterface.plots.lawfit import plot_friction_fit
+
+        fig = plot_friction_fit(friction, t.name)
+        save_figure(fig, folder / "friction_fit.png", target=t.name)
     return result.design.save(folder / "design.json", **record, **extra)

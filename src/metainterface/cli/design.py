@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from metainterface._names import DEFAULT_MODEL, METHOD_NAMES, MODEL_NAMES
+from metainterface._names import DEFAULT_MODEL, FIT_NAMES, METHOD_NAMES, MODEL_NAMES
 from metainterface.cli.common import add_device, positive_int
 
 
@@ -37,11 +37,29 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="CSV normal_force,friction_force [N] (or normal_force,friction_coefficient)"
         "; needs --shear-strength --modulus --radius --area",
     )
+    src.add_argument(
+        "--fit",
+        choices=FIT_NAMES,
+        default="auto",
+        help="replace the friction rows by a monotone smooth fit (a cubic spline, knots by "
+        "cross-validation): auto (default) fits rows with scatter, repeated or unsorted loads, "
+        "or 5-9 rows; the fit is drawn in friction_fit.png",
+    )
     phys = p.add_argument_group("physical units (with --friction-csv, or for a physical block)")
-    phys.add_argument("--shear-strength", help="interface shear strength tau, e.g. 0.25MPa")
-    phys.add_argument("--modulus", help="equivalent modulus E*, e.g. 2MPa")
+    phys.add_argument(
+        "--shear-strength",
+        help="interface shear strength tau, e.g. 0.25MPa (or a range, as --area)",
+    )
+    phys.add_argument(
+        "--modulus", help="equivalent modulus E*, e.g. 2MPa (or a range, e.g. 1MPa..20MPa)"
+    )
     phys.add_argument("--radius", help="asperity radius R, e.g. 0.5mm")
-    phys.add_argument("--area", help="nominal area of the whole interface, e.g. 4cm2")
+    phys.add_argument(
+        "--area",
+        help="nominal area of the whole interface, e.g. 4cm2; with --friction-csv also "
+        "'auto' or a range (2cm2..10cm2): the area is designed with the cell (one of --area, "
+        "--modulus, --shear-strength may be free)",
+    )
     phys.add_argument("--total-force", help="total normal force, e.g. 10N (number of cells)")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument(
@@ -138,7 +156,7 @@ def _targets(args: argparse.Namespace) -> list:
 
     targets = [mi.Target.builtin(n) for n in args.target]
     targets += [mi.Target.from_csv(f) for f in args.target_csv]
-    if args.friction_csv:
+    if args.friction_csv and not _scale_free(args):
         given = {
             "--shear-strength": args.shear_strength,
             "--modulus": args.modulus,
@@ -158,11 +176,89 @@ def _targets(args: argparse.Namespace) -> list:
                 modulus=args.modulus,
                 radius=args.radius,
                 area=args.area,
+                fit=args.fit,
             )
         )
+        fit = targets[-1].meta["friction"].get("fit")
+        if fit is not None:
+            print(f"{targets[-1].name}: {fit['summary']}")
+        _advise(args, targets[-1].name)
     if not targets:
         raise mi.MetainterfaceError("give at least one --target, --target-csv or --friction-csv")
     return targets
+
+
+def _scale_free(args: argparse.Namespace) -> bool:
+    """Whether --area, --modulus or --shear-strength is 'auto' or a range."""
+    return any(
+        v is not None and (v.strip().lower() == "auto" or ".." in v)
+        for v in (args.area, args.modulus, args.shear_strength)
+    )
+
+
+def _advise(args: argparse.Namespace, name: str) -> None:
+    """Before designing a friction law at a fixed scale: where it is out of reach, say
+    which area, modulus or shear strength would bring it in."""
+    import metainterface as mi
+
+    fs = mi.feasible_scale(
+        args.friction_csv,
+        shear_strength=args.shear_strength,
+        modulus=args.modulus,
+        radius=args.radius,
+        area=args.area,
+        fit=args.fit,
+    )
+    if not fs.reachable:
+        for line in fs.summary():
+            print(f"{name}: {line}")
+        print(f"{name}: --area auto (or a range, e.g. --modulus 1MPa..20MPa) chooses it")
+
+
+def _design_scale(args: argparse.Namespace, options: dict) -> list:
+    """--friction-csv with a free area, modulus or shear strength: the scale designed too."""
+    import metainterface as mi
+    from metainterface.api.scale import scale_line
+
+    if args.target or args.target_csv or args.compare:
+        raise mi.MetainterfaceError(
+            "a free --area/--modulus/--shear-strength ('auto' or a range) designs one "
+            "--friction-csv alone; leave out --target, --target-csv and --compare"
+        )
+    missing = [
+        name
+        for name, value in (
+            ("--shear-strength", args.shear_strength),
+            ("--modulus", args.modulus),
+            ("--radius", args.radius),
+        )
+        if value is None
+    ]
+    if missing:
+        raise mi.MetainterfaceError(f"--friction-csv needs {', '.join(missing)}")
+    for key in ("modulus", "radius", "area"):  # the scale search sets them
+        options.pop(key)
+    if args.total_force is None:
+        options.pop("total_force")
+    r = mi.design_scale(
+        args.friction_csv,
+        shear_strength=args.shear_strength,
+        modulus=args.modulus,
+        radius=args.radius,
+        area=args.area or "auto",
+        fit=args.fit,
+        method=args.method,
+        out=args.out,
+        **options,
+    )
+    fit = r.target.meta["friction"].get("fit")
+    if fit is not None:
+        print(f"{r.target.name}: {fit['summary']}")
+    # the feasible ranges (the line on the scale 'given' would name the range's middle)
+    for line in r.target.meta["scale"]["feasibility"]["summary"][1:]:
+        print(f"{r.target.name}: {line}")
+    print(scale_line(r))
+    return [r]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -170,7 +266,7 @@ def run(args: argparse.Namespace) -> int:
 
     import metainterface as mi
 
-    targets = _targets(args)
+    targets = [] if args.friction_csv and _scale_free(args) else _targets(args)
     options = dict(
         refine=args.refine == "lbfgs",
         surrogate=args.model,
@@ -218,6 +314,8 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace, targets: list, options: dict) -> list:
     import metainterface as mi
 
+    if not targets:  # a friction law with its scale free: the scale is designed too
+        return _design_scale(args, options)
     if args.compare:
         if args.html:
             raise mi.MetainterfaceError("--html draws one design per page; leave out --compare")

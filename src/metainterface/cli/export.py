@@ -18,7 +18,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("design", help="design file (metainterface/design-v1 JSON)")
     p.add_argument("--radius", required=True, help="asperity radius R, e.g. 0.5mm")
-    p.add_argument("--tiles", default="1x1", help="cells along x and y, e.g. 4x4 (default 1x1)")
+    p.add_argument(
+        "--tiles",
+        default="1x1",
+        help="cells along x and y, e.g. 4x4 (default 1x1); auto: the tiling design.json "
+        "records for the area designed for (e.g. by design --area auto)",
+    )
     p.add_argument(
         "--format",
         choices=EXPORT_FORMATS,

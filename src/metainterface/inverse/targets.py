@@ -125,6 +125,7 @@ class Target:
         area: str | float,
         settings: CellSettings | None = None,
         name: str | None = None,
+        fit: str = "auto",
     ) -> Target:
         """A target from a friction law: a CSV ``normal_force,friction_force`` [N] (or
         ``normal_force,friction_coefficient``), one row per load.
@@ -132,6 +133,10 @@ class Target:
         shear_strength tau, modulus E*, radius R, area (nominal area of the whole interface):
         quantities with units ('0.25MPa', '0.5mm', '4cm2') or numbers in SI. Bowden-Tabor:
         alpha = F_f / (tau A), P* = F_n / (A E*). The conversion is kept in ``meta``.
+        fit: "auto" replaces measured rows that are not a law as they stand (scatter,
+        repeated or unsorted loads) or fewer than 10 rows by a monotone smooth fit,
+        "always" or "never" force it; the fit and its residual are in
+        ``meta["friction"]["fit"]``.
         """
         from metainterface.physical.friction import friction_target
         from metainterface.physical.units import parse_area, parse_length, parse_pressure
@@ -143,6 +148,7 @@ class Target:
             radius=parse_length(radius, option="radius"),
             area=parse_area(area, option="area"),
             settings=settings,
+            fit=fit,
         )
         return cls(
             p_star=ft.p_star,

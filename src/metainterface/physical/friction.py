@@ -24,13 +24,24 @@ from typing import Any
 import numpy as np
 
 from metainterface._files.columns import read_columns, read_text_lines
+from metainterface._names import FIT_NAMES
 from metainterface.errors import MetainterfaceError
+from metainterface.physical._lawfit import LawFit, fit_law
 from metainterface.physics.cell import CellSettings
 
 FORCE_COLUMNS = ("normal_force", "friction_force")
 COEFFICIENT_COLUMNS = ("normal_force", "friction_coefficient")
 #: Points a target needs (the design command's minimum), the added origin included.
 MIN_POINTS = 3
+#: When the measured rows are replaced by a monotone fit (:mod:`._lawfit`): "auto" fits
+#: rows that are not a law as they stand (unsorted, repeated loads, friction that falls
+#: with scatter) or fewer than FIT_BELOW_ROWS of them; "always" and "never" force it.
+FIT_CHOICES = FIT_NAMES
+#: Under fit="auto", a valid law of FIT_MIN_ROWS to FIT_BELOW_ROWS - 1 rows is fitted:
+#: straight lines between a handful of points make a target with kinks that no smooth
+#: contact curve follows (fewer rows are too few to fit a curve to; they are kept).
+FIT_BELOW_ROWS = 10
+FIT_MIN_ROWS = 5
 
 
 @dataclass(frozen=True)
@@ -54,11 +65,12 @@ def _header(path: Path) -> list[str]:
     return []
 
 
-def read_friction_csv(path: str | os.PathLike[str]) -> FrictionLaw:
+def read_friction_csv(path: str | os.PathLike[str], *, check: bool = True) -> FrictionLaw:
     """Read a friction curve: ``normal_force,friction_force`` or ``...,friction_coefficient``.
 
-    Forces in newtons, the coefficient dimensionless. Checks every row (finite, >= 0, normal
-    force strictly increasing, friction never decreasing, no friction at zero load).
+    Forces in newtons, the coefficient dimensionless. Every value finite and >= 0; with
+    ``check`` also the rows as a law (normal force strictly increasing, friction never
+    decreasing, no friction at zero load), else the rows as measured (any order, repeats).
     """
     path = Path(path)
     header = _header(path)
@@ -85,7 +97,11 @@ def read_friction_csv(path: str | os.PathLike[str]) -> FrictionLaw:
         rows=np.arange(1, friction.size + 1),
         source=str(path),
     )
-    check_law(law)
+    if check:
+        check_law(law)
+    else:
+        _check_values(law.source, "normal_force", law.normal_force)
+        _check_values(law.source, "friction_force", law.friction_force)
     return law
 
 
@@ -190,6 +206,7 @@ class FrictionTarget:
     area: float
     n_cells: float
     settings: CellSettings = field(default_factory=CellSettings)
+    fit: LawFit | None = None
 
     def columns(self) -> dict[str, np.ndarray]:
         """{'p_star', 'alpha'}: the target as the design command's CSV columns."""
@@ -206,7 +223,60 @@ class FrictionTarget:
             "n_cells": self.n_cells,
             "normal_force_n": [float(v) for v in self.law.normal_force],
             "friction_force_n": [float(v) for v in self.law.friction_force],
+            **({} if self.fit is None else {"fit": fit_record(self.fit)}),
         }
+
+
+def fit_record(fit: LawFit) -> dict[str, Any]:
+    """JSON-ready description of a law fit: the method, its residual and the raw data [N]."""
+    return {
+        "method": "monotone cubic B-spline, knots by GCV",
+        "interior_knots": fit.interior_knots,
+        "residual_rms_n": fit.residual_rms,
+        "relative_residual": fit.relative_residual,
+        "raw_normal_force_n": [float(v) for v in fit.raw_normal],
+        "raw_friction_force_n": [float(v) for v in fit.raw_friction],
+        "summary": fit.summary(),
+    }
+
+
+def prepare_law(
+    law: FrictionLaw | str | os.PathLike[str], fit: str = "auto"
+) -> tuple[FrictionLaw, LawFit | None]:
+    """The law to design for, and the fit when the rows were replaced by one.
+
+    fit: "auto" (fit rows that are not a law as they stand, or 5 to 9 rows of a law),
+    "always" or "never" (the rows must then be a law).
+    """
+    if fit not in FIT_CHOICES:
+        raise MetainterfaceError(f"fit must be one of {', '.join(FIT_CHOICES)}, got {fit!r}")
+    if not isinstance(law, FrictionLaw):
+        law = read_friction_csv(law, check=False)
+    if fit == "never":
+        check_law(law)
+        return law, None
+    if fit == "auto":
+        try:
+            check_law(law)
+        except MetainterfaceError:
+            pass
+        else:
+            if not FIT_MIN_ROWS <= law.normal_force.size < FIT_BELOW_ROWS:
+                return law, None
+    _check_values(law.source, "normal_force", law.normal_force)
+    _check_values(law.source, "friction_force", law.friction_force)
+    loads = np.unique(law.normal_force[law.normal_force > 0])
+    if loads.size < MIN_POINTS:
+        raise MetainterfaceError(
+            f"{law.source}: fitting a law needs at least {MIN_POINTS} distinct positive normal "
+            f"forces, got {loads.size}"
+        )
+    lf = fit_law(law.normal_force, law.friction_force)
+    fn, ff = lf.sample()
+    fitted = FrictionLaw(
+        normal_force=fn, friction_force=ff, rows=np.arange(fn.size), source=law.source
+    )
+    return fitted, lf
 
 
 def friction_target(
@@ -218,13 +288,16 @@ def friction_target(
     area: float,
     settings: CellSettings | None = None,
     include_origin: bool = True,
+    fit: str = "auto",
 ) -> FrictionTarget:
     """Convert a friction law (a FrictionLaw or a CSV path) into the alpha(P*) target.
 
     shear_strength tau [Pa], e_star E* [Pa], radius R [m], area: nominal area of the whole
     interface [m^2], all > 0 (parse them with ``metainterface.physical.units``). settings: the cell
     (default: the paper's), used for L. include_origin: prepend (0 N, 0 N) when the first load
-    is > 0 (F_f = tau A_real vanishes with the load). Errors name the row.
+    is > 0 (F_f = tau A_real vanishes with the load). fit: "auto", "always" or "never",
+    when the rows are replaced by a monotone smooth fit (:func:`prepare_law`; the fit is
+    kept in ``fit``). Errors name the row.
     """
     settings = settings or CellSettings()
     for name, value in (
@@ -235,10 +308,7 @@ def friction_target(
     ):
         if not (math.isfinite(value) and value > 0):
             raise MetainterfaceError(f"{name} must be finite and > 0, got {value!r}")
-    if not isinstance(law, FrictionLaw):
-        law = read_friction_csv(law)
-    else:
-        check_law(law)
+    law, lf = prepare_law(law, fit)
     if include_origin and law.normal_force[0] > 0:
         law = FrictionLaw(
             normal_force=np.concatenate([[0.0], law.normal_force]),
@@ -283,6 +353,7 @@ def friction_target(
         area=float(area),
         n_cells=area / cell_area,
         settings=settings,
+        fit=lf,
     )
 
 
@@ -294,6 +365,7 @@ def friction_target_from_options(
     radius: str | None,
     area: str | None,
     settings: CellSettings | None = None,
+    fit: str = "auto",
 ) -> FrictionTarget:
     """:func:`friction_target` from command-line strings with units ('0.25MPa', '4cm2').
 
@@ -320,4 +392,5 @@ def friction_target_from_options(
         radius=parse_length(radius, option="--radius"),
         area=parse_area(area, option="--area"),
         settings=settings,
+        fit=fit,
     )

@@ -1,0 +1,336 @@
+"""A friction law's scale in the user's units: which area, modulus or shear strength makes
+it reachable (:func:`feasible_scale`), and a design with that scale chosen together with the
+cell (:func:`design_scale`)."""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from metainterface.errors import MetainterfaceError
+from metainterface.inverse import scale as _scale
+from metainterface.inverse.refine import RefineSettings
+from metainterface.inverse.targets import Target
+from metainterface.physics.cell import CellSettings
+
+#: Candidate scales designed quickly before the chosen one is designed in full.
+CANDIDATES = 5
+#: The quick design of each candidate: a short refinement, no fallback multistart.
+QUICK = RefineSettings(stages=2, steps_per_stage=3, iterations=20, polish_iterations=20)
+#: Options of the three scale variables, as the error messages name them.
+_OPTIONS = {"area": "area", "modulus": "modulus", "shear_strength": "shear_strength"}
+
+
+def _parser(var: str):
+    from metainterface.physical.units import parse_area, parse_pressure
+
+    return parse_area if var == "area" else parse_pressure
+
+
+def parse_scale(
+    value: Any, var: str, option: str | None = None
+) -> tuple[float | None, tuple[float, float] | None]:
+    """(value, None) for a fixed scale, (None, (low, high)) for a range ('2cm2..10cm2', a
+    pair) or (None, None) for 'auto' (the whole default search). SI."""
+    option = option or _OPTIONS[var]
+    parse = _parser(var)
+    if isinstance(value, str) and value.strip().lower() == "auto":
+        return None, None
+    if isinstance(value, str) and ".." in value:
+        parts = value.split("..")
+        if len(parts) != 2:
+            raise MetainterfaceError(f"{option}: a range is LOW..HIGH, e.g. 2cm2..10cm2")
+        lo, hi = (parse(x.strip(), option=option) for x in parts)
+    elif isinstance(value, tuple | list):
+        if len(value) != 2:
+            raise MetainterfaceError(f"{option}: a range is a pair (low, high), got {value!r}")
+        lo, hi = (parse(x, option=option) for x in value)
+    else:
+        return parse(value, option=option), None
+    if not lo < hi:
+        raise MetainterfaceError(f"{option}: the range's low end must be below its high end")
+    return None, (lo, hi)
+
+
+def _law_and_scale(
+    law: Any,
+    shear_strength: Any,
+    modulus: Any,
+    radius: Any,
+    area: Any,
+    fit: str,
+) -> tuple[Any, Any, dict[str, float], str | None, tuple[float, float] | None]:
+    """(law, fit, given SI scale, the variable left free or None, its bounds)."""
+    from metainterface.physical.friction import prepare_law
+    from metainterface.physical.units import parse_length
+
+    values = {"area": area, "modulus": modulus, "shear_strength": shear_strength}
+    given: dict[str, float] = {}
+    free: list[tuple[str, tuple[float, float] | None]] = []
+    for var, v in values.items():
+        fixed, span = parse_scale(v, var)
+        if fixed is None:
+            free.append((var, span))
+        else:
+            given[var] = fixed
+    if len(free) > 1:
+        raise MetainterfaceError(
+            f"give a range or 'auto' for one of area, modulus, shear_strength at a time "
+            f"(got {', '.join(v for v, _ in free)})"
+        )
+    var, span = free[0] if free else (None, None)
+    if var is not None:  # the search starts from the middle of the range
+        given[var] = math.sqrt(span[0] * span[1]) if span else math.nan
+    law, lf = prepare_law(law, fit)
+    given["radius"] = parse_length(radius, option="radius")
+    return law, lf, given, var, span
+
+
+def _reference(law: Any, given: dict[str, float], var: str | None) -> dict[str, float]:
+    """The given scale, an 'auto' variable set where the law's largest point sits at half
+    the cell's largest reachable P* (area, modulus) or alpha = 0.02 (tau)."""
+    if var is None or math.isfinite(given[var]):
+        return given
+    from metainterface.inverse.pipeline import reachable_envelope
+
+    _, _, reach = reachable_envelope(np.zeros(1), CellSettings())
+    fn, ff = float(law.normal_force.max()), float(law.friction_force.max())
+    g = dict(given)
+    if var == "area":
+        g["area"] = fn / (0.5 * reach * g["modulus"])
+    elif var == "modulus":
+        g["modulus"] = fn / (0.5 * reach * g["area"])
+    else:
+        g["shear_strength"] = ff / (0.02 * g["area"])
+    return g
+
+
+def feasible_scale(
+    law: str | os.PathLike[str] | Any,
+    *,
+    shear_strength: str | float,
+    modulus: str | float,
+    radius: str | float,
+    area: str | float,
+    settings: CellSettings | None = None,
+    fit: str = "auto",
+) -> _scale.FeasibleScale:
+    """Which area, modulus E* or shear strength tau makes a friction law reachable.
+
+    law: a CSV ``normal_force,friction_force`` [N] (or a FrictionLaw), fitted as in
+    :meth:`Target.from_friction` (``fit``). shear_strength, modulus, radius, area: the scale
+    as given ('0.25MPa', '2MPa', '0.5mm', '4cm2', or SI numbers); one of area, modulus,
+    shear_strength may be a range ('2cm2..10cm2') to search within. The radius moves nothing
+    (P* and alpha are averages over the area); it sets how many cells tile it.
+
+    Returns a FeasibleScale: ``.reachable`` at the given scale, ``.ranges`` per variable
+    (SI intervals that make it reachable, the other two as given), ``.best``,
+    ``.summary()`` (lines in the user's units, e.g. 'reachable with an area of 6.1-9.8
+    cm^2'), ``.record()``.
+    """
+    law, _, given, var, span = _law_and_scale(law, shear_strength, modulus, radius, area, fit)
+    given = _reference(law, given, var)
+    return _scale.feasible_scale(
+        law.normal_force,
+        law.friction_force,
+        area=given["area"],
+        modulus=given["modulus"],
+        shear_strength=given["shear_strength"],
+        radius=given["radius"],
+        settings=settings,
+        bounds=None if span is None else {var: span},
+    )
+
+
+def _candidates(fs: _scale.FeasibleScale, var: str, count: int) -> np.ndarray:
+    """Values of ``var`` to design: spread (in log) over its feasible ranges, else around
+    the least-violating value."""
+    spans = fs.ranges[var]
+    lo_b, hi_b = fs.bounds[var]
+    if spans:
+        lo, hi = spans[0][0], spans[-1][1]
+        if len(spans) > 1:  # several ranges: the widest one
+            lo, hi = max(spans, key=lambda s: s[1] / s[0])
+        # keep off the envelope's edges, where the pointwise estimate is least sure
+        inner = (hi / lo) ** 0.1
+        return np.geomspace(lo * inner, hi / inner, count) if hi / lo > 1.01 else np.array([lo])
+    b = fs.best[var]
+    return np.clip(np.geomspace(b / 1.3, b * 1.3, count), lo_b, hi_b)
+
+
+def uncovered(result: Any) -> float:
+    """The share of a target's pressure range its design does not reach by Delta_max.
+
+    The relative curve error holds a design's alpha at its last value past its reach, so a
+    design that stops short of the law can score well; the scale search adds this share to
+    the error, so that it prefers a scale whose design carries the whole law."""
+    import torch
+
+    g, h = result.design.tensors()
+    with torch.no_grad():
+        zero = torch.zeros(1, 1, dtype=g.dtype)
+        _, p_max = result.model.alpha_at(g, h, result.design.settings, zero)
+    top = float(result.target.p_star_max)
+    return max(0.0, 1.0 - float(p_max[0]) / top) if top > 0 else 0.0
+
+
+def _closer(values: np.ndarray, errors: np.ndarray) -> np.ndarray:
+    """Second-round candidates: the geometric midpoints between the best value and its
+    neighbours, and the vertex of the parabola through the three in (log value, log error)
+    where it falls between them (a step of golden-section-like refinement, on a batch)."""
+    k = int(np.argmin(errors))
+    lo, hi = max(k - 1, 0), min(k + 1, values.size - 1)
+    x = np.log(values)
+    out = [float(np.exp(0.5 * (x[lo] + x[k]))), float(np.exp(0.5 * (x[k] + x[hi])))]
+    if 0 < k < values.size - 1:
+        y = np.log(np.maximum(errors[lo : hi + 1], 1e-12))
+        c = np.polyfit(x[lo : hi + 1], y, 2)
+        if c[0] > 0:
+            v = -c[1] / (2 * c[0])
+            if x[lo] < v < x[hi]:
+                out.append(float(np.exp(v)))
+    out = np.unique([v for v in out if not np.isclose(v, values, rtol=1e-3).any()])
+    return np.asarray(out, dtype=np.float64)
+
+
+def design_scale(
+    law: str | os.PathLike[str] | Any,
+    *,
+    shear_strength: str | float,
+    modulus: str | float,
+    radius: str | float,
+    area: str | float = "auto",
+    settings: CellSettings | None = None,
+    fit: str = "auto",
+    name: str | None = None,
+    candidates: int = CANDIDATES,
+    **options: Any,
+) -> Any:
+    """Design a cell for a friction law with the scale chosen together with it.
+
+    One of area, modulus, shear_strength is 'auto' or a range ('2cm2..10cm2'; area defaults
+    to 'auto'), the others fixed. The scales that make the law reachable are found
+    (:func:`feasible_scale`); ``candidates`` values spread over them (or, where none is
+    reachable, around the closest) are each designed with a short refinement, in one batch,
+    then up to three more between the best and its neighbours; the one
+    with the smallest error is designed in full with ``options`` (as
+    :func:`~metainterface.design`, e.g. ``method``, ``seed``, ``out``).
+
+    A candidate's score is its quick design's relative curve error plus the share of the
+    law's pressure range the design does not reach by Delta_max.
+
+    Returns the DesignResult; ``result.target.meta["scale"]`` holds the chosen value, the
+    tiling it gives (cells and cells per side), the candidates and their scores and the
+    feasibility summary, and design.json records them.
+    """
+    from metainterface.api.functions import design
+    from metainterface.physical.friction import FrictionLaw, friction_target
+
+    source = str(law) if not isinstance(law, FrictionLaw) else law.source
+    law, lf, given, var, span = _law_and_scale(law, shear_strength, modulus, radius, area, fit)
+    if var is None:
+        raise MetainterfaceError(
+            "design_scale: give area, modulus or shear_strength as 'auto' or a range "
+            "(e.g. area='2cm2..10cm2'); with all three fixed use design()"
+        )
+    if not isinstance(candidates, int) or not 1 <= candidates <= 32:
+        raise MetainterfaceError(f"candidates must be an integer in [1, 32], got {candidates!r}")
+    given = _reference(law, given, var)
+    s = settings or CellSettings()
+    fs = _scale.feasible_scale(
+        law.normal_force,
+        law.friction_force,
+        area=given["area"],
+        modulus=given["modulus"],
+        shear_strength=given["shear_strength"],
+        radius=given["radius"],
+        settings=s,
+        bounds=None if span is None else {var: span},
+    )
+    values = _candidates(fs, var, candidates)
+    stem = name or (os.path.splitext(os.path.basename(source))[0] or "friction")
+
+    def target(value: float, label: str) -> Target:
+        at = {**given, var: float(value)}
+        ft = friction_target(
+            law,
+            shear_strength=at["shear_strength"],
+            e_star=at["modulus"],
+            radius=at["radius"],
+            area=at["area"],
+            settings=settings,
+            fit="never",
+        )
+        record = ft.record()
+        if lf is not None:
+            from metainterface.physical.friction import fit_record
+
+            record["fit"] = fit_record(lf)
+        return Target(
+            p_star=ft.p_star, alpha=ft.alpha, name=label, source=source, meta={"friction": record}
+        )
+
+    quick_opts = {k: v for k, v in options.items() if k in ("method", "seed", "model", "hedge")}
+
+    def quick(vals: np.ndarray) -> np.ndarray:
+        made = design(
+            [target(v, f"{stem}-{i}") for i, v in enumerate(vals)],
+            settings=settings,
+            refine_settings=QUICK,
+            fallback=0,
+            **quick_opts,
+        )
+        return np.array([r.error + uncovered(r) for r in made])
+
+    errors = quick(values)
+    if values.size >= 3:  # a second round between the best and its neighbours
+        more = _closer(values, errors)
+        if more.size:
+            values = np.concatenate([values, more])
+            errors = np.concatenate([errors, quick(more)])
+            order = np.argsort(values)
+            values, errors = values[order], errors[order]
+    k = int(np.argmin(errors))
+    chosen = float(values[k])
+    at = {**given, var: chosen}
+    n_cells, per_side = fs.tiles(at["area"])
+    t = target(chosen, stem)
+    t = replace(
+        t,
+        meta={
+            **t.meta,
+            "scale": {
+                "variable": var,
+                "value": chosen,
+                "searched": list(fs.bounds[var]),
+                "candidates": [float(v) for v in values],
+                "candidate_scores": [float(e) for e in errors],
+                "n_cells": n_cells,
+                "tiles_per_side": per_side,
+                "feasibility": fs.record(),
+            },
+        },
+    )
+    phys = {"modulus": at["modulus"], "radius": at["radius"]}
+    if "total_force" not in options:
+        phys["area"] = at["area"]
+    return design(t, settings=settings, **phys, **options)
+
+
+def scale_line(result: Any) -> str | None:
+    """One line on the scale a design chose, in the user's units, or None."""
+    sc = result.target.meta.get("scale") if isinstance(result.target.meta, dict) else None
+    if not sc:
+        return None
+    fmt = _scale.fmt_area if sc["variable"] == "area" else _scale.fmt_pressure
+    what = {"area": "area", "modulus": "E*", "shear_strength": "tau"}[sc["variable"]]
+    n, side = sc["n_cells"], sc["tiles_per_side"]
+    return (
+        f"{result.target.name}: chose {what} = {fmt(sc['value'])} of "
+        f"{fmt(sc['searched'][0])}-{fmt(sc['searched'][1])} ({len(sc['candidates'])} "
+        f"candidates), {n:.4g} cells ({side}x{side} tiles), error {100 * result.error:.3g} %"
+    )

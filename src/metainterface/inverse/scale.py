@@ -1,0 +1,269 @@
+"""The scale of a friction law as a design variable: which area, modulus or shear strength
+makes the law reachable by the cell.
+
+A law in newtons becomes the target alpha = F_f / (tau A), P* = F_n / (A E*) (Bowden and
+Tabor, paper sec. 2.3). Scaling the nominal area A by k moves every point along its ray
+through the origin (P*, alpha) -> (P*, alpha) / k; scaling E* by k moves P* alone, tau by k
+alpha alone. The radius R does not move the target (P* and alpha are averages over the
+nominal area); it sets the cell side L R and so how many cells tile the area. The cell
+reaches, at each P*, an envelope of alpha (:func:`~metainterface.inverse.pipeline.
+reachable_envelope`); a scale is feasible when every point of the law lies inside it (within
+``tolerance``) and below the largest P* any design reaches. The envelope is pointwise, so a
+feasible scale is necessary for a close design, not a proof of one: the design decides.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from metainterface.errors import MetainterfaceError
+from metainterface.inverse.pipeline import reachable_envelope
+from metainterface.physics.cell import CellSettings
+
+#: The scale variables: how a factor k on each moves the target (P*, alpha).
+VARIABLES = ("area", "modulus", "shear_strength")
+#: Decades searched either side of the given value, and grid points per decade (a 1 %
+#: step: finer than any unit the ranges are reported in).
+DECADES = 3.0
+PER_DECADE = 230
+#: Relative slack on the envelope, as the reachability warnings use.
+TOLERANCE = 0.05
+
+
+def _moved(p: np.ndarray, a: np.ndarray, variable: str, k: np.ndarray) -> tuple[Any, Any]:
+    """(S, K) targets for factors k (S,) on ``variable``, from the law's (K,) target."""
+    kk = k[:, None]
+    if variable == "area":
+        return p[None] / kk, a[None] / kk
+    if variable == "modulus":
+        return p[None] / kk, np.broadcast_to(a[None], (k.size, a.size))
+    return np.broadcast_to(p[None], (k.size, p.size)), a[None] / kk
+
+
+def violation(
+    p_star: np.ndarray, alpha: np.ndarray, settings: CellSettings, tolerance: float = TOLERANCE
+) -> tuple[np.ndarray, np.ndarray]:
+    """How far targets (S, K) leave the reachable envelope: (mean violation (S,), points
+    outside (S,)). A point's violation is the log-ratio by which it misses the envelope
+    (0 inside); beyond the largest reachable P*, the log-ratio of its pressure to that."""
+    lo, hi, reach = reachable_envelope(p_star, settings)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = np.maximum(alpha, 1e-300)
+        below = np.log(np.maximum(lo * (1 - tolerance) / a, 1.0))
+        above = np.log(np.maximum(a / (hi * (1 + tolerance)), 1.0))
+        beyond = np.log(np.maximum(p_star / reach, 1.0))
+        v = np.where(p_star > reach, beyond + 1.0, below + above)
+    v = np.where(p_star > 0, v, 0.0)
+    return v.mean(-1), (v > 0).sum(-1)
+
+
+@dataclass(frozen=True)
+class FeasibleScale:
+    """Which scales make a friction law reachable by the cell.
+
+    given: the scale asked for, SI ({'area': m^2, 'modulus': Pa, 'shear_strength': Pa,
+    'radius': m}). outside: points of the law outside the envelope at the given scale (of
+    ``points``). ranges: per variable, the intervals [SI] that make it reachable with the
+    other two as given (empty: none within 10^3 of the given value and the bounds). best:
+    per variable, the value with the smallest violation (the middle of the widest range
+    where there is one), and ``best_outside`` the points still outside there. bounds: per
+    variable, the (low, high) the search was limited to [SI].
+    """
+
+    given: dict[str, float]
+    outside: int
+    points: int
+    ranges: dict[str, list[tuple[float, float]]]
+    best: dict[str, float]
+    best_outside: dict[str, int]
+    bounds: dict[str, tuple[float, float]] = field(default_factory=dict)
+    cell_area: float = 0.0
+
+    @property
+    def reachable(self) -> bool:
+        """Whether the law is reachable at the given scale."""
+        return self.outside == 0
+
+    def tiles(self, area: float) -> tuple[float, int]:
+        """(cells, cells per side) that tile a nominal area [m^2]."""
+        n = area / self.cell_area
+        return n, math.ceil(math.sqrt(n) - 1e-9)
+
+    def summary(self) -> list[str]:
+        """One or two lines in the user's units: reachable or not, and what to change."""
+        g = self.given
+        at = f"E* = {fmt_pressure(g['modulus'])}, tau = {fmt_pressure(g['shear_strength'])}"
+        head = (
+            f"reachable at the given scale (area {fmt_area(g['area'])}, {at})"
+            if self.reachable
+            else f"not reachable at area {fmt_area(g['area'])}, {at}: {self.outside} of "
+            f"{self.points} points outside what the cell reaches"
+        )
+        options = []
+        for var in VARIABLES:
+            spans = self.ranges.get(var, [])
+            if not spans:
+                continue
+            text = " or ".join(_span(var, lo, hi) for lo, hi in spans)
+            options.append(f"{_NAMES[var]} of {text}")
+        if options:
+            tail = "reachable with " + "; or with ".join(options) + " (the others as given)"
+        else:
+            var = min(self.best, key=lambda v: self.best_outside[v])
+            tail = (
+                f"no area, E* or tau within 10^{DECADES:g} of the given makes it reachable; "
+                f"closest: {_NAMES[var]} {_fmt(var, self.best[var])} "
+                f"({self.best_outside[var]} points outside)"
+            )
+        return [head, tail]
+
+    def record(self) -> dict[str, Any]:
+        """JSON-ready, SI."""
+        return {
+            "given": self.given,
+            "outside": self.outside,
+            "points": self.points,
+            "ranges": {k: [list(s) for s in v] for k, v in self.ranges.items()},
+            "best": self.best,
+            "best_outside": self.best_outside,
+            "summary": self.summary(),
+        }
+
+
+_NAMES = {"area": "an area", "modulus": "E*", "shear_strength": "tau"}
+
+
+def fmt_area(a: float) -> str:
+    """An area [m^2] in mm^2, cm^2 or m^2, three significant digits."""
+    for unit, f, at in (("m^2", 1.0, 0.1), ("cm^2", 1e-4, 1e-4), ("mm^2", 1e-6, 0.0)):
+        if a >= at:
+            return f"{a / f:.3g} {unit}"
+    raise AssertionError  # pragma: no cover
+
+
+def fmt_pressure(p: float) -> str:
+    """A pressure [Pa] in Pa, kPa, MPa or GPa, three significant digits."""
+    for unit, f in (("GPa", 1e9), ("MPa", 1e6), ("kPa", 1e3), ("Pa", 1.0)):
+        if p >= f or unit == "Pa":
+            return f"{p / f:.3g} {unit}"
+    raise AssertionError  # pragma: no cover
+
+
+def _fmt(var: str, v: float) -> str:
+    return fmt_area(v) if var == "area" else fmt_pressure(v)
+
+
+def _span(var: str, lo: float, hi: float) -> str:
+    """'6.1-9.8 cm^2' (one unit) or '800 kPa-1.2 MPa'."""
+    a, b = _fmt(var, lo), _fmt(var, hi)
+    ua, ub = a.split(" ", 1)[1], b.split(" ", 1)[1]
+    return f"{a.split(' ', 1)[0]}-{b}" if ua == ub else f"{a}-{b}"
+
+
+def _runs(ok: np.ndarray) -> list[tuple[int, int]]:
+    """Index ranges [i, j] of the True runs in a boolean row."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+#: Feasible ranges closer than this ratio are reported as one: the envelope is an estimate
+#: from a finite family of cells, and a gap of a grid step or two is its noise.
+MERGE_RATIO = 1.15
+
+
+def _merged(runs: list[tuple[int, int]], values: np.ndarray) -> list[tuple[int, int]]:
+    out: list[tuple[int, int]] = []
+    for i, j in runs:
+        if out and values[i] / values[out[-1][1]] < MERGE_RATIO:
+            out[-1] = (out[-1][0], j)
+        else:
+            out.append((i, j))
+    return out
+
+
+def scan(
+    p_star: np.ndarray,
+    alpha: np.ndarray,
+    variable: str,
+    given: float,
+    bounds: tuple[float, float],
+    settings: CellSettings,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(values (S,) SI, mean violation (S,), points outside (S,)) over a log grid of the
+    variable within ``bounds``, from the target at the ``given`` value."""
+    lo, hi = bounds
+    steps = max(2, round(math.log10(hi / lo) * PER_DECADE) + 1)
+    values = np.geomspace(lo, hi, steps)
+    p, a = _moved(p_star, alpha, variable, values / given)
+    v, out = violation(np.asarray(p), np.asarray(a), settings)
+    return values, v, out
+
+
+def feasible_scale(
+    normal_force: np.ndarray,
+    friction_force: np.ndarray,
+    *,
+    area: float,
+    modulus: float,
+    shear_strength: float,
+    radius: float,
+    settings: CellSettings | None = None,
+    bounds: dict[str, tuple[float, float]] | None = None,
+) -> FeasibleScale:
+    """Which area, modulus or shear strength makes the law (F_n, F_f) (K,) [N] reachable.
+
+    area [m^2], modulus E* [Pa], shear_strength tau [Pa], radius R [m]: the scale given.
+    bounds: per variable, (low, high) [SI] to search in (default 10^-3 to 10^3 times the
+    given value; the area at least one cell (L R)^2 and large enough that alpha < 1).
+    """
+    s = settings or CellSettings()
+    given = {"area": area, "modulus": modulus, "shear_strength": shear_strength}
+    fn = np.asarray(normal_force, dtype=np.float64)
+    ff = np.asarray(friction_force, dtype=np.float64)
+    p0, a0 = fn / (area * modulus), ff / (shear_strength * area)
+    cell_area = (s.cell_side / s.radius * radius) ** 2
+    _, out0 = violation(p0[None], a0[None], s)
+    lim = {v: (given[v] * 10**-DECADES, given[v] * 10**DECADES) for v in VARIABLES}
+    # alpha < 1 needs A > F_f / tau and tau > F_f / A; the area holds at least one cell
+    floor = {
+        "area": max(cell_area, float(ff.max()) / shear_strength * 1.0001),
+        "shear_strength": float(ff.max()) / area * 1.0001,
+        "modulus": 0.0,
+    }
+    lim = {v: (max(lo, floor[v]), hi) for v, (lo, hi) in lim.items()}
+    for var, (lo, hi) in (bounds or {}).items():
+        if var not in VARIABLES:
+            raise MetainterfaceError(f"bounds: unknown variable {var!r} ({', '.join(VARIABLES)})")
+        lim[var] = (max(lo, floor[var]), hi)
+    ranges: dict[str, list[tuple[float, float]]] = {}
+    best: dict[str, float] = {}
+    best_out: dict[str, int] = {}
+    for var in VARIABLES:
+        lo, hi = lim[var]
+        if not lo < hi:
+            ranges[var], best[var], best_out[var] = [], lo, int(p0.size)
+            continue
+        values, v, out = scan(p0, a0, var, given[var], (lo, hi), s)
+        runs = _merged(_runs(out == 0), values)
+        ranges[var] = [(float(values[i]), float(values[j])) for i, j in runs]
+        if runs:  # the middle (in log) of the widest range: the most room either side
+            i, j = max(runs, key=lambda r: r[1] - r[0])
+            best[var] = float(math.sqrt(values[i] * values[j]))
+            best_out[var] = 0
+        else:
+            k = int(np.lexsort((v, out))[0])
+            best[var], best_out[var] = float(values[k]), int(out[k])
+    return FeasibleScale(
+        given={**given, "radius": radius},
+        outside=int(out0[0]),
+        points=int(p0.size),
+        ranges=ranges,
+        best=best,
+        best_outside=best_out,
+        bounds=lim,
+        cell_area=cell_area,
+    )
