@@ -123,9 +123,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         write_result,
     )
     from metainterface.api.reach import reachability
-    from metainterface.errors import MetainterfaceError, UnreachableError
     from metainterface.api.scale import design_scale, feasible_scale
-    from metainterface.errors import MetainterfaceError
+    from metainterface.errors import MetainterfaceError, UnreachableError
     from metainterface.inverse.scale import FeasibleScale
     from metainterface.inverse.targets import Target
     from metainterface.physical.reach import Reachability
