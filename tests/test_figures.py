@@ -235,7 +235,12 @@ def test_design_figure_csv_target(csv_result, width):
     assert area.get_xlim()[0] == 0 and area.get_xlim()[1] >= t.p_star_max
     assert area.get_ylim()[0] == 0 and stiff.get_ylim()[0] == 0
     # the target's own S* line beside the design's
-    assert [ln.get_label() for ln in stiff.get_lines()] == ["target (differences)", "design"]
+    # (and, where the zero-shot design stops short of the target, the mark of where)
+    labels = [ln.get_label() for ln in stiff.get_lines() if ln.get_label() != "design stops"]
+    assert labels == ["target (differences)", "design"]
+    assert ("design stops" in [ln.get_label() for ln in stiff.get_lines()]) == (
+        csv_result.coverage < 1
+    )
     # the error with significant digits in the title, never "0.00 %"
     assert "error" in fig.get_suptitle() and "0.00 %" not in fig.get_suptitle()
 

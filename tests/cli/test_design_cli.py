@@ -143,9 +143,13 @@ def test_design_cli_area_auto_and_fit(tmp_path, capsys):
     assert json.loads((tmp_path / "patch.npy.json").read_text())["tiles"] == [n, n]
     capsys.readouterr()
     fixed = tmp_path / "fixed"
-    assert main([*base, "--area", "1000cm2", "--out", str(fixed)]) == 0
-    text = capsys.readouterr().out
-    assert "not reachable at area" in text
-    assert "reachable with" in text and "--area auto" in text
+    # out of reach at the area given: refused (exit 2, nothing written), with the scales that
+    # would reach it and the reachable friction coefficients
+    assert main([*base, "--area", "1000cm2", "--out", str(fixed)]) == 2
+    said = capsys.readouterr()
+    assert "not reachable at area" in said.out
+    assert "reachable with" in said.out and "--area auto" in said.out
+    assert "a cell reaches mu" in said.err and "--force" in said.err
+    assert not (fixed / "design.json").exists()
     assert main([*base, "--area", "auto", "--target", "linear", "--out", str(fixed)]) == 2
     assert "alone" in capsys.readouterr().err
