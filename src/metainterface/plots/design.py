@@ -97,6 +97,8 @@ def plot_design(result, curve, *, width: float | None = None) -> Figure:
     ax_p = fig.add_subplot(spots[-2])
     ax_c = fig.add_subplot(spots[-1])
     what = f"{result.method} design, error {percent(result.error)}"
+    if getattr(result, "bem", None) is not None:
+        what += f", BEM {percent(result.bem.bem_error)}"
     name = short(t.name, max(16, min(40, int(5 * width))))
     one_line = len(name) + len(what) + 2 <= min(60, 9 * width)
     fig.suptitle(f"{name}: {what}" if one_line else f"{name}\n{what}", fontsize=11)
@@ -105,6 +107,16 @@ def plot_design(result, curve, *, width: float | None = None) -> Figure:
     p_top = 1.03 * max(t.p_star_max, float(curve.p_star[-1]))
     ax_a.plot(t.p_star[keep], t.alpha[keep], "k-", lw=2, label="target")
     ax_a.plot(curve.p_star, curve.alpha, "--", color="C0", label="design")
+    bem = getattr(result, "bem", None)
+    if bem is not None:  # the design solved in BEM at the check's loads
+        ax_a.plot(
+            bem.p_star,
+            bem.alpha_bem,
+            "o",
+            color="C3",
+            ms=4,
+            label=f"BEM {bem.grid}$^2$: {percent(bem.bem_error)}",
+        )
     ax_a.set(xlabel=r"$P^* = P/E^*$", ylabel=r"$\alpha = A/A_{nom}$", title="contact area")
     ax_a.set_xlim(0, p_top)
     ax_a.set_ylim(bottom=0)

@@ -98,7 +98,9 @@ def re_refine(
     grid = TargetGrid.from_curves([curve], rs.grid_points)
     gamma = torch.as_tensor(design.gamma, dtype=DTYPE)[None]
     h = torch.as_tensor(design.h, dtype=DTYPE)[None]
-    raw = polish(param.from_design(gamma, h, settings), settings, grid, rs, param, extra_loss, model)
+    raw = polish(
+        param.from_design(gamma, h, settings), settings, grid, rs, param, extra_loss, model
+    )
     g, hh = param.to_design(raw.detach(), settings)
     return Design(gamma=g[0].numpy().copy(), h=hh[0].numpy().copy(), settings=settings)
 
