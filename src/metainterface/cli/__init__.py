@@ -41,7 +41,12 @@ ALL_OR_NOTHING = frozenset({"curve", "export", "generate", "evaluate"})
 
 #: Library argument names that a command's options spell differently.
 OPTION_NAMES = {
-    "design": {"model": "--physics", "surrogate": "--model"},
+    "design": {
+        "model": "--physics",
+        "surrogate": "--model",
+        "grid": "--verify-grid",
+        "loads": "--verify-loads",
+    },
     "curve": {"model": "--physics"},
     "validate": {"model": "--physics"},
 }

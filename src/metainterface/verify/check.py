@@ -24,7 +24,7 @@ import numpy as np
 from metainterface import _checks
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
-from metainterface.physics.cell import Design
+from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.models import ForwardModel, get_model
 
 #: Grid points per lattice cell side of the default check grid: M = 128 n (384 for N = 9).
@@ -98,13 +98,13 @@ class Verify:
                 argument="device",
             )
 
-    def grid_for(self, design: Design) -> int:
-        """The check's grid for this design's cell (checked against it)."""
+    def grid_for(self, cell: CellSettings) -> int:
+        """The check's grid for this cell (checked against it)."""
         from metainterface.validation import check_grid
 
         if self.grid is None:
-            return GRID_PER_ASPERITY * design.settings.n_side
-        return check_grid(self.grid, design.settings)
+            return GRID_PER_ASPERITY * cell.n_side
+        return check_grid(self.grid, cell)
 
     def wants_correction(self, check: BemCheck) -> bool:
         """Whether a design with this check is corrected."""
@@ -232,7 +232,7 @@ def solve_bem(design: Design, loads: np.ndarray, settings: Verify, model: Forwar
     from metainterface.validation import plan_validation, require_tamaas
 
     require_tamaas()
-    grid = settings.grid_for(design)
+    grid = settings.grid_for(design.settings)
     plan = plan_validation(design, grid=grid, loads=loads, model=model)
     t0 = time.perf_counter()
     result = plan.solve(1)
