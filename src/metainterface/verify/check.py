@@ -262,7 +262,7 @@ def bem_check(
     solved = solve_bem(design, loads, settings, fm)
     alpha_t = np.interp(loads, target.p_star, target.alpha)
     notes = ()
-    if loads[-1] < target.p_star_max * (1 - 1e-9):
+    if loads[-1] < target.p_star_max * (1 - 1e-3):  # a design short by a hair is not
         notes = (
             f"the design reaches P* = {loads[-1]:.4g} at Delta_max, short of the target's "
             f"{target.p_star_max:.4g}: the check stops there",
