@@ -89,6 +89,10 @@ def test_design_outputs_are_strict_json(tmp_path, capsys):
             "2",
             "--out",
             str(tmp_path / "d"),
+            "--verify-grid",
+            "96",
+            "--verify-loads",
+            "3",
         ],
         capsys,
     )
