@@ -10,7 +10,7 @@ Start here::
     import metainterface as mi
     t = mi.Target.builtin("bilinear")        # or mi.Target(p_star=..., alpha=...),
                                              # mi.Target.from_csv, mi.Target.from_friction
-    r = mi.design(t)                         # DesignResult: .design, .error, .plot()
+    r = mi.design(t)                         # DesignResult: .design, .error, .bem_error, .plot()
     c = mi.curve(r.design, model="interacting")   # Curve: numpy p_star, alpha, stiffness
     v = mi.validate(r.design, grid=96, loads=4)   # BEM check (Tamaas, the [bem] extra)
     mi.export(r.design, "patch.stl", radius="0.5mm", tiles=(2, 2))
@@ -19,6 +19,9 @@ Targets and designs
     Target, Design, CellSettings
 Designing
     design, compare, DesignResult, pressure_check, physical
+Checked in BEM
+    Verify (how design checks, and corrects, each design in BEM), BemCheck (the BEM curve
+    and its error to the target: DesignResult.bem)
 Curves and forward models
     curve, Curve, ForwardModel, Independent, Interacting, MODELS, get_model, register_model
 Checking and making
@@ -89,6 +92,8 @@ _HOMES: dict[str, str] = {
     "tune_allocator": "metainterface.runtime",
     "TrainConfig": "metainterface.surrogate.train",
     "ValidationResult": "metainterface.validation.validate",
+    "BemCheck": "metainterface.verify.check",
+    "Verify": "metainterface.verify.check",
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
@@ -127,6 +132,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.runtime import tune_allocator
     from metainterface.surrogate.train import TrainConfig
     from metainterface.validation.validate import ValidationResult
+    from metainterface.verify.check import BemCheck, Verify
 
 
 def __getattr__(name: str) -> Any:
@@ -163,6 +169,7 @@ sys.modules[__name__].__class__ = _Face
 
 __all__ = [
     "MODELS",
+    "BemCheck",
     "CellSettings",
     "Curve",
     "Design",
@@ -176,6 +183,7 @@ __all__ = [
     "ToleranceResult",
     "TrainConfig",
     "ValidationResult",
+    "Verify",
     "__version__",
     "compare",
     "curve",

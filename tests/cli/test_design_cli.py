@@ -78,6 +78,7 @@ def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, ca
     out = tmp_path / "out"
     args = [
         "design",
+        "--no-verify",
         "--friction-csv",
         str(csv),
         "--shear-strength",
@@ -94,7 +95,6 @@ def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, ca
         "none",
         "--max-pressure",
         "0.5",
-        "--no-verify",
     ]
     assert main(args) == 0, capsys.readouterr().err
     data = json.loads((out / "design.json").read_text())
