@@ -15,3 +15,6 @@ DEFAULT_MODEL = "independent"
 METHOD_NAMES: tuple[str, ...] = ("surrogate", "multistart", "hertz")
 #: The export formats (``io.export.FORMATS``).
 EXPORT_FORMATS: tuple[str, ...] = ("stl", "png", "tiff", "npy")
+#: The BEM contact solvers (``validation.engines.ENGINES``), and the default one.
+ENGINE_NAMES: tuple[str, ...] = ("torch", "tamaas")
+DEFAULT_ENGINE = "torch"

@@ -78,8 +78,25 @@ def test_malformed_design_file(tmp_path, capsys):
 
 def test_missing_tamaas_says_how_to_install(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "tamaas", None)  # import tamaas -> ImportError
-    assert main(["validate", EXAMPLE, "--out", str(tmp_path / "run")]) == 2
+    run = ["validate", EXAMPLE, "--engine", "tamaas", "--out", str(tmp_path / "run")]
+    assert main(run) == 2
     assert "pip install 'metainterface[bem]'" in one_line_error(capsys)
+    # the default engine needs no Tamaas
+    args = ["validate", EXAMPLE, "--grid", "48", "--loads", "2", "--workers", "1"]
+    assert main([*args, "--device", "cpu", "--out", str(tmp_path / "torch")]) == 0
+    assert "(torch engine)" in capsys.readouterr().out
+
+
+def test_bad_engine_and_device_are_one_line_errors(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["validate", EXAMPLE, "--engine", "nope", "--out", str(tmp_path)])
+    assert exc.value.code == 2
+    assert "--engine: invalid choice" in capsys.readouterr().err
+    assert main(["validate", EXAMPLE, "--device", "tpu", "--out", str(tmp_path / "a")]) == 2
+    assert "device must be one of auto, cpu, cuda" in one_line_error(capsys)
+    run = ["validate", EXAMPLE, "--engine", "tamaas", "--device", "cuda"]
+    assert main([*run, "--out", str(tmp_path / "b")]) == 2
+    assert "device" in one_line_error(capsys)
 
 
 def test_validate_physics_reports_both(tmp_path, capsys):

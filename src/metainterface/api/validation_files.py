@@ -42,6 +42,7 @@ from metainterface._files import (
     write_columns,
     write_text,
 )
+from metainterface._names import DEFAULT_ENGINE
 from metainterface.api.cluster import check_scheduler, dask_executor
 from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, open_fields, require_xarray, write_fields
@@ -53,9 +54,9 @@ from metainterface.validation.bem import (
     TOLERANCE,
     LoadPath,
     available_cpus,
-    require_tamaas,
 )
 from metainterface.validation.engine import RETRIES, solve_task, stream
+from metainterface.validation.engines import check_engine, get_engine
 from metainterface.validation.validate import (
     DEFAULT_LOADS,
     ValidationPlan,
@@ -82,8 +83,10 @@ def validate(
     fields: bool = False,
     executor: Executor | None = None,
     scheduler: str | None = None,
+    engine: str = DEFAULT_ENGINE,
+    device: str = "auto",
 ) -> ValidationResult:
-    """Check a design against the boundary element method (Tamaas, the ``bem`` extra).
+    """Check a design against the boundary element method.
 
     Parameters
     ----------
@@ -115,6 +118,12 @@ def validate(
     scheduler : str
         Or a Dask scheduler: ``"tcp://HOST:PORT"`` to join a running cluster, ``"local"`` to
         start a LocalCluster of ``jobs`` processes (the ``distributed`` extra).
+    engine : str
+        The contact solver: ``"torch"`` (default; the base install, CPU threads or a GPU)
+        or ``"tamaas"`` (the ``bem`` extra, CPU; the reference).
+    device : str
+        Where the torch engine solves: ``"auto"`` (a CUDA device if torch sees one, else
+        the CPU), ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
 
     Returns
     -------
@@ -122,7 +131,7 @@ def validate(
         numpy ``p_star``, ``alpha_bem``, ``alpha_model``, ``rel_err`` (K,), and summaries
         (``max_rel_err_upper``, ``target_errors()``).
     """
-    require_tamaas()
+    check_engine(engine, device)
     if out is not None:  # before the solve: a bad folder should not cost a BEM run
         check_output_folder(out)
     if fields and out is not None:
@@ -148,7 +157,15 @@ def validate(
             )
         loads = [p_max * i / k for i in range(1, k + 1)]
     plan = plan_validation(
-        design, grid, loads, name=name, model=fm, tolerance=tolerance, max_iter=max_iter
+        design,
+        grid,
+        loads,
+        name=name,
+        model=fm,
+        tolerance=tolerance,
+        max_iter=max_iter,
+        engine=engine,
+        device=device,
     )
     n_loads = len(plan.loads)
     jobs = min(available_cpus(), n_loads) if jobs is None else check_jobs(jobs)
@@ -201,7 +218,8 @@ def result_settings(result: ValidationResult, **extra: Any) -> dict[str, Any]:
         "model": result.model.label,
         "tolerance": result.tolerance,
         "max_iter": result.max_iter,
-        "solver": "tamaas PolonskyKeerRey, basic_2d, E* = 1",
+        "engine": result.engine,
+        "solver": get_engine(result.engine).solver,
         **extra,
     }
 
@@ -243,7 +261,13 @@ def write_result(
         )
         save_figure(fig, out / "validation.png", **settings)
     request = validation_request(
-        result.design, result.grid, result.p_star, result.model, result.tolerance, result.max_iter
+        result.design,
+        result.grid,
+        result.p_star,
+        result.model,
+        result.tolerance,
+        result.max_iter,
+        engine=result.engine,
     )
     record = {
         "request": request,
@@ -334,6 +358,10 @@ def _stored(folder: Path, request: dict[str, Any], fields: bool, figure: bool) -
         record = json.loads((folder / "result.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
+    stored = record.get("request")
+    if isinstance(stored, dict) and "engine" not in stored and request.get("engine") == "tamaas":
+        # results written before there were engines were Tamaas's
+        request = {k: v for k, v in request.items() if k != "engine"}
     if record.get("request_hash") != request_hash(request) or record.get("request") != request:
         return None
     if fields and not (folder / FIELDS_FILE).exists():
@@ -420,6 +448,8 @@ def validate_many(
     scheduler: str | None = None,
     retries: int = RETRIES,
     progress: bool = True,
+    engine: str = DEFAULT_ENGINE,
+    device: str = "auto",
 ) -> dict[str, dict[str, Any]]:
     """Validate many designs against BEM, on local processes or any executor.
 
@@ -454,6 +484,9 @@ def validate_many(
         Times a task lost by the engine (a worker that died) is submitted again.
     progress : bool
         A progress bar over the designs.
+    engine, device : str
+        The contact solver and where torch runs, as in ``validate``. The engine is part of
+        each stored request: a sweep resumed with another engine solves its designs again.
 
     Returns
     -------
@@ -469,8 +502,13 @@ def validate_many(
     fails (e.g. no convergence) gets error.txt and the sweep goes on; it is tried again on
     the next run.
     """
-    require_tamaas()
+    solver = check_engine(engine, device)
     jobs = available_cpus() if jobs is None else check_jobs(jobs)
+    if executor is None and scheduler is None and solver.name == "torch" and jobs > 1:
+        from metainterface._device import resolve_device
+
+        if resolve_device(device).type == "cuda":
+            jobs = 1  # one process drives the GPU (a forked child cannot use CUDA)
     chunks = _checks.whole("chunks", chunks, low=1, high=10_000)
     retries = _checks.whole("retries", retries, low=0, high=100)
     if fields:
@@ -493,6 +531,8 @@ def validate_many(
                 model=model,
                 tolerance=tolerance,
                 max_iter=max_iter,
+                engine=engine,
+                device=device,
             )
         except MetainterfaceError as exc:
             raise MetainterfaceError(f"{name}: {exc}") from None
@@ -509,6 +549,7 @@ def validate_many(
         "model": get_model(model).label,
         "tolerance": tolerance,
         "max_iter": max_iter,
+        "engine": get_engine(engine).name,
     }
 
     def write_summary() -> None:
@@ -519,8 +560,10 @@ def validate_many(
 
     # one design's chunks: (design index in todo, its tasks); flat list for the engine
     tasks, owner = [], []
+    # in this process (no executor, one job) torch keeps its threads; workers run on one
+    threads = None if executor is None and scheduler is None and jobs <= 1 else 1
     for d, prep in enumerate(todo):
-        for task in prep.tasks(chunks, fields=fields):
+        for task in prep.tasks(chunks, fields=fields, threads=threads):
             tasks.append(task)
             owner.append(d)
     parts: dict[int, dict[int, LoadPath]] = {d: {} for d in range(len(todo))}

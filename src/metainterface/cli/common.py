@@ -24,3 +24,14 @@ def positive_float(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
     return value
+
+
+def add_device(parser: argparse.ArgumentParser) -> None:
+    """``--device``: where torch runs, resolved (and refused in one line) by the library's
+    ``resolve_device``."""
+    parser.add_argument(
+        "--device",
+        default="auto",
+        metavar="DEVICE",
+        help="auto, cpu, cuda or cuda:N",
+    )

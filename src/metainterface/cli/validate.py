@@ -1,4 +1,4 @@
-"""`metainterface validate`: designs against the boundary element method (Tamaas).
+"""`metainterface validate`: designs against the boundary element method.
 
 One design file: its results in DIR (``mi.validate``). Several files or a folder: a sweep,
 DIR/<name>/ per design and DIR/summary.csv (``mi.validate_many``), on local processes or a
@@ -10,16 +10,17 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
-from metainterface.cli.common import positive_float, positive_int
+from metainterface._names import DEFAULT_ENGINE, DEFAULT_MODEL, ENGINE_NAMES, MODEL_NAMES
+from metainterface.cli.common import add_device, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "validate",
-        help="compare a design's alpha(P*) with a BEM solution (Tamaas)",
-        description="Solve the normal contact of the design's periodic cell with Tamaas "
-        "(Polonsky-Keer-Rey, tolerance 1e-11, E* = 1) at K ascending mean pressures up to "
+        help="compare a design's alpha(P*) with a BEM solution",
+        description="Solve the normal contact of the design's periodic cell by the boundary "
+        "element method (Polonsky-Keer-Rey, tolerance 1e-11, E* = 1; --engine torch, the "
+        "default, or tamaas, the [bem] extra) at K ascending mean pressures up to "
         "the load reached at Delta_max, and compare the contact-area fraction with the "
         "forward model. The BEM's contact edges are placed to sub-pixel accuracy from the "
         "pressure field (p^2 is linear near a smooth edge); the plain count of grid points "
@@ -105,6 +106,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="forward model that sets the loads and alpha_model: the paper's independent "
         "asperities (default) or with their elastic interaction; both are reported",
     )
+    p.add_argument(
+        "--engine",
+        choices=ENGINE_NAMES,
+        default=DEFAULT_ENGINE,
+        help="contact solver: torch (default; CPU threads or a GPU, no extra needed) or "
+        "tamaas (the [bem] extra; the reference, one CPU thread)",
+    )
+    add_device(p)
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.set_defaults(func=run)
 
@@ -126,11 +135,13 @@ def run(args: argparse.Namespace) -> int:
         out=args.out,
         fields=args.fields,
         scheduler=args.scheduler,
+        engine=args.engine,
+        device=args.device,
     )
     rel = {name: result.alpha_bem / a - 1.0 for name, a in result.alpha_by_model.items()}
     k = len(result.p_star)
     print(
-        f"{args.out}: {k} loads on {result.grid}x{result.grid}, "
+        f"{args.out}: {k} loads on {result.grid}x{result.grid} ({result.engine} engine), "
         f"solves {result.seconds.sum():.1f} s; max p/E* = {result.p_max.max():.4g}"
     )
     print(
@@ -171,6 +182,8 @@ def run_many(args: argparse.Namespace) -> int:
         fields=args.fields,
         chunks=args.chunks or 1,
         scheduler=args.scheduler,
+        engine=args.engine,
+        device=args.device,
     )
     failed = [name for name, s in summaries.items() if "error" in s]
     worst = max(

@@ -1,7 +1,8 @@
-"""Validation of the forward models against the boundary element method (Tamaas).
+"""Validation of the forward models against the boundary element method.
 
-Tamaas is imported only when a solve starts (``bem.require_tamaas``), so this package loads,
-and gives a clear message, without it.
+Two contact solvers (``engines``): our own in torch (the default, ``torch_bem``) and Tamaas
+(the ``bem`` extra, the reference). Tamaas is imported only when its engine is asked for
+(``bem.require_tamaas``), so this package loads, and gives a clear message, without it.
 """
 
 from metainterface.validation.bem import (
@@ -12,6 +13,14 @@ from metainterface.validation.bem import (
     require_tamaas,
     solve_loads,
     solve_path,
+)
+from metainterface.validation.engines import (
+    ENGINES,
+    TamaasEngine,
+    TorchEngine,
+    check_engine,
+    get_engine,
+    torch_threads,
 )
 from metainterface.validation.heightmap import (
     HeightMap,
@@ -35,18 +44,23 @@ from metainterface.validation.validate import (
 
 __all__ = [
     "DEFAULT_LOADS",
+    "ENGINES",
     "MAX_ITER",
     "TOLERANCE",
     "HeightMap",
     "LoadPath",
+    "TamaasEngine",
+    "TorchEngine",
     "ValidationPlan",
     "ValidationResult",
     "available_cpus",
     "cell_height_map",
+    "check_engine",
     "check_grid",
     "check_jobs",
     "default_grid",
     "design_target",
+    "get_engine",
     "height_map",
     "owner_map",
     "plan_validation",
@@ -54,6 +68,7 @@ __all__ = [
     "resolve_loads",
     "solve_loads",
     "solve_path",
+    "torch_threads",
     "validate_design",
     "validation_request",
 ]

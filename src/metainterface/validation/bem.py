@@ -1,13 +1,14 @@
-"""Normal contact of a periodic cell with the boundary element method (Tamaas; paper sec. 4.1).
+"""Normal contact of a periodic cell with the boundary element method (paper sec. 4.1).
 
 A rigid periodic surface (the cell's height map, tips up) is pressed on an elastic half-space
 with E* = 1 (E = 1, nu = 0), so pressures are P* = P / E* and p / E*. The Polonsky-Keer-Rey
 solver (tolerance 1e-11) is driven by the mean pressure; a load path of ascending pressures
-starts each solve from the previous solution (Tamaas keeps the traction field between solves).
+starts each solve from the previous solution.
 
-Only numpy and Tamaas are used here, so the functions run in worker processes without torch.
-The Tamaas wheel is single-threaded and holds the GIL: parallelism is by processes
-(``solve_loads`` with ``jobs > 1`` splits a load path into contiguous chunks).
+Two engines solve it (``engines``): our own in torch (``torch_bem``, the default) and
+Tamaas's (``tamaas_path``, the ``bem`` extra). Parallelism over a load path is by processes
+(``solve_loads`` with ``jobs > 1`` splits it into contiguous chunks, each solved on one
+torch thread); one process may also run torch on several threads.
 """
 
 from __future__ import annotations
@@ -145,7 +146,99 @@ def contact_area(
     return float(per.sum()), per, float(count.sum()) / (m * m)
 
 
+class PathRecorder:
+    """Collects the solved loads of a path (K loads on an M x M grid) into a ``LoadPath``."""
+
+    def __init__(self, k: int, m: int, owner: np.ndarray, n_asperities: int, fields: bool):
+        self.alpha, self.alpha_pixels, self.p_max, self.residual, self.seconds = (
+            np.empty(k) for _ in range(5)
+        )
+        self.per = np.empty((k, n_asperities))
+        self.owner = np.asarray(owner).ravel()
+        self.n_asperities = n_asperities
+        self.pressures = np.empty((k, m, m)) if fields else None
+        self.gaps = np.empty((k, m, m)) if fields else None
+        self.pressure: np.ndarray | None = None
+
+    def record(
+        self, i: int, pressure: np.ndarray, gap: np.ndarray | None, err: float, seconds: float
+    ) -> None:
+        """Load i: its (M, M) pressure p / E* and gap [length], solver error and time."""
+        self.alpha[i], self.per[i], self.alpha_pixels[i] = contact_area(
+            pressure, self.owner, self.n_asperities
+        )
+        self.p_max[i] = float(pressure.max())
+        self.residual[i] = err
+        self.seconds[i] = seconds
+        if self.pressures is not None and self.gaps is not None and gap is not None:
+            self.pressures[i] = pressure
+            self.gaps[i] = gap
+        self.pressure = np.array(pressure, copy=True)
+
+    def path(self) -> LoadPath:
+        assert self.pressure is not None
+        return LoadPath(
+            self.alpha,
+            self.alpha_pixels,
+            self.p_max,
+            self.per,
+            self.residual,
+            self.seconds,
+            self.pressure,
+            self.pressures,
+            self.gaps,
+        )
+
+
 def solve_path(
+    heights: np.ndarray,
+    cell_side: float,
+    loads: np.ndarray,
+    owner: np.ndarray,
+    n_asperities: int,
+    *,
+    engine: Any = None,
+    device: Any = "auto",
+    threads: int | None = None,
+    tolerance: float = TOLERANCE,
+    max_iter: int = MAX_ITER,
+    first_index: int = 0,
+    total: int | None = None,
+    report: Callable[[int], Any] | None = None,
+    fields: bool = False,
+) -> LoadPath:
+    """Solve the contact of one cell at ascending mean pressures ``loads`` (K,) [P* = P/E*].
+
+    heights: (M, M) surface [length], tips up; cell_side: L [same length]; owner: (M, M)
+    asperity index of each grid point. engine: "torch" (default) or "tamaas"
+    (``engines.ENGINES``); device: where torch solves ("auto", "cpu", "cuda", "cuda:N");
+    threads: torch threads for the solve (None: as set). The first load starts from a
+    uniform pressure, each next one from the previous solution. ``report(1)`` is called
+    after each load. ``first_index`` and ``total`` only number the loads in error messages
+    (for chunks of a longer path). fields: also keep the pressure and gap fields of every
+    load (``LoadPath.pressures``, ``gaps``; 2 K M^2 floats). Raises MetainterfaceError
+    naming the load and the residual if a solve does not converge.
+    """
+    from metainterface.validation.engines import get_engine
+
+    return get_engine(engine).solve_path(
+        heights,
+        cell_side,
+        loads,
+        owner,
+        n_asperities,
+        tolerance=tolerance,
+        max_iter=max_iter,
+        first_index=first_index,
+        total=total,
+        report=report,
+        fields=fields,
+        device=device,
+        threads=threads,
+    )
+
+
+def tamaas_path(
     heights: np.ndarray,
     cell_side: float,
     loads: np.ndarray,
@@ -159,16 +252,8 @@ def solve_path(
     report: Callable[[int], Any] | None = None,
     fields: bool = False,
 ) -> LoadPath:
-    """Solve the contact of one cell at ascending mean pressures ``loads`` (K,) [P* = P/E*].
-
-    heights: (M, M) surface [length], tips up; cell_side: L [same length]; owner: (M, M)
-    asperity index of each grid point. The first load starts from zero traction, each next
-    one from the previous solution. ``report(1)`` is called after each load. ``first_index``
-    and ``total`` only number the loads in error messages (for chunks of a longer path).
-    fields: also keep the pressure and gap fields of every load (``LoadPath.pressures``,
-    ``gaps``; 2 K M^2 floats). Raises MetainterfaceError naming the load and the residual
-    if a solve does not converge.
-    """
+    """``solve_path`` with Tamaas's PolonskyKeerRey (one thread; Tamaas keeps the traction
+    field between solves, which warm-starts each load from the previous one)."""
     tm = require_tamaas()
     loads = np.asarray(loads, dtype=np.float64)
     total = len(loads) if total is None else total
@@ -234,12 +319,13 @@ def _report_to_queue(n: int) -> None:
 
 
 def _solve_task(kwargs: dict[str, Any]) -> LoadPath:
-    return solve_path(**kwargs, report=_report_to_queue)
+    # a forked worker runs torch on one thread (several hang after a multi-threaded parent)
+    return solve_path(**{"threads": 1, **kwargs}, report=_report_to_queue)
 
 
 def _context() -> mp.context.BaseContext:
-    # fork: workers start in milliseconds and need no imports (they run numpy + Tamaas only,
-    # never torch). Where fork is unavailable or unsafe (macOS, Windows), spawn.
+    # fork: workers start in milliseconds and need no imports (torch runs there on one
+    # thread). Where fork is unavailable or unsafe (macOS, Windows), spawn.
     if sys.platform.startswith("linux"):
         return mp.get_context("fork")
     return mp.get_context("spawn")  # pragma: no cover
@@ -357,6 +443,8 @@ def solve_loads(
     n_asperities: int,
     *,
     jobs: int = 1,
+    engine: Any = None,
+    device: Any = "auto",
     tolerance: float = TOLERANCE,
     max_iter: int = MAX_ITER,
     weights: np.ndarray | None = None,
@@ -376,6 +464,8 @@ def solve_loads(
         cell_side=cell_side,
         owner=owner,
         n_asperities=n_asperities,
+        engine=engine,
+        device=device,
         tolerance=tolerance,
         max_iter=max_iter,
         total=len(loads),

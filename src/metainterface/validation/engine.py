@@ -38,7 +38,8 @@ RETRIES = 2
 @dataclass(frozen=True)
 class BemTask:
     """One BEM solve: ``loads`` (k,) ascending P*, loads first_index .. first_index + k - 1
-    of a path of ``total``, of ``design`` on a grid x grid map."""
+    of a path of ``total``, of ``design`` on a grid x grid map, by ``engine`` on ``device``
+    (resolved in the worker) with torch on ``threads`` threads (None: as set there)."""
 
     design: Design
     grid: int
@@ -48,6 +49,9 @@ class BemTask:
     tolerance: float
     max_iter: int
     fields: bool = False
+    engine: str = "torch"
+    device: str = "auto"
+    threads: int | None = 1
 
 
 @contextlib.contextmanager
@@ -80,6 +84,9 @@ def solve_task(task: BemTask) -> LoadPath:
         first_index=task.first_index,
         total=task.total,
         fields=task.fields,
+        engine=task.engine,
+        device=task.device,
+        threads=task.threads,
     )
 
 

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
+from metainterface._names import DEFAULT_ENGINE
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, ModelCurve, get_model, models_at
@@ -30,11 +31,11 @@ from metainterface.validation.bem import (
     MAX_ITER,
     TOLERANCE,
     LoadPath,
-    require_tamaas,
     solve_loads,
     split_path,
 )
 from metainterface.validation.engine import BemTask, solve_task, stream
+from metainterface.validation.engines import check_engine
 from metainterface.validation.heightmap import HeightMap, check_grid, default_grid, height_map
 
 #: Default number of loads of a path.
@@ -76,6 +77,8 @@ class ValidationResult:
     pressures, gaps : ndarray, shape (K, M, M), or None
         p / E* and the gap [units of R] at every load, kept when solved with
         ``fields=True`` (written by ``write_result`` as fields.nc).
+    engine : str
+        The contact solver that made it ("torch" or "tamaas").
     """
 
     name: str
@@ -98,6 +101,7 @@ class ValidationResult:
     curve: ModelCurve
     pressures: np.ndarray | None = None
     gaps: np.ndarray | None = None
+    engine: str = DEFAULT_ENGINE
 
     @property
     def rel_err(self) -> np.ndarray:
@@ -178,6 +182,7 @@ class ValidationResult:
         )
         return {
             "name": self.name,
+            "engine": self.engine,
             "loads": len(self.p_star),
             "grid": self.grid,
             "model": self.model.label,
@@ -245,7 +250,8 @@ class ValidationPlan:
     """A checked validation case, ready to solve: ``plan_validation(...).solve(jobs)``.
 
     Light on purpose (no grids, no dense curves), so a sweep can plan thousands of designs.
-    loads: (K,) the P* of the path, ascending.
+    loads: (K,) the P* of the path, ascending. engine: the contact solver's name; device:
+    where the torch engine runs (resolved where it solves).
     """
 
     name: str
@@ -255,6 +261,8 @@ class ValidationPlan:
     tolerance: float
     max_iter: int
     loads: np.ndarray
+    engine: str = DEFAULT_ENGINE
+    device: str = "auto"
 
     def model_curve(self) -> ModelCurve:
         """The forward model's dense curve of the design."""
@@ -275,12 +283,20 @@ class ValidationPlan:
             n_asperities=self.design.n_asperities,
             tolerance=self.tolerance,
             max_iter=self.max_iter,
+            engine=self.engine,
+            device=self.device,
         )
 
     def request(self) -> dict[str, Any]:
         """What a stored result must match to be reused (see ``validate_many``)."""
         return validation_request(
-            self.design, self.grid, self.loads, self.model, self.tolerance, self.max_iter
+            self.design,
+            self.grid,
+            self.loads,
+            self.model,
+            self.tolerance,
+            self.max_iter,
+            engine=self.engine,
         )
 
     def load_weights(self, curve: ModelCurve | None = None) -> np.ndarray:
@@ -291,9 +307,15 @@ class ValidationPlan:
         return np.maximum(curve.at(self.loads)[0], 1e-12) ** 0.125
 
     def tasks(
-        self, chunks: int = 1, *, fields: bool = False, curve: ModelCurve | None = None
+        self,
+        chunks: int = 1,
+        *,
+        fields: bool = False,
+        curve: ModelCurve | None = None,
+        threads: int | None = 1,
     ) -> list[BemTask]:
-        """The path as ``chunks`` contiguous warm-started tasks of about equal cost."""
+        """The path as ``chunks`` contiguous warm-started tasks of about equal cost; torch
+        runs on ``threads`` threads in the worker (None: as set there)."""
         weights = self.load_weights(curve) if chunks > 1 else None
         parts = split_path(len(self.loads), chunks, weights)
         return [
@@ -306,6 +328,9 @@ class ValidationPlan:
                 tolerance=self.tolerance,
                 max_iter=self.max_iter,
                 fields=fields,
+                engine=self.engine,
+                device=self.device,
+                threads=threads,
             )
             for c in parts
         ]
@@ -325,6 +350,11 @@ class ValidationPlan:
         """
         jobs = check_jobs(jobs)
         heights, curve = self.height_map(), self.model_curve()
+        if executor is None and jobs > 1 and self.engine == "torch":
+            from metainterface._device import resolve_device
+
+            if resolve_device(self.device).type == "cuda":
+                jobs = 1  # one process drives the GPU (a forked child cannot use CUDA)
         if executor is None:
             path = solve_loads(
                 **self.task(heights),
@@ -380,6 +410,7 @@ class ValidationPlan:
             curve=curve,
             pressures=path.pressures,
             gaps=path.gaps,
+            engine=self.engine,
         )
 
 
@@ -399,11 +430,15 @@ def plan_validation(
     model: str | ForwardModel | None = None,
     tolerance: float = TOLERANCE,
     max_iter: int = MAX_ITER,
+    engine: str = DEFAULT_ENGINE,
+    device: str = "auto",
 ) -> ValidationPlan:
     """Check every input and fix the load path; the BEM solve is ``.solve(jobs)``.
 
-    Arguments as in ``validate_design``. Raises MetainterfaceError on bad input.
+    Arguments as in ``validate_design``. Raises MetainterfaceError on bad input (an unknown
+    engine, Tamaas missing for engine="tamaas", a device torch does not see).
     """
+    solver = check_engine(engine, device)
     if isinstance(max_iter, bool) or not (isinstance(max_iter, int | np.integer) and max_iter >= 1):
         raise MetainterfaceError(f"max_iter must be a whole number >= 1, got {max_iter!r}")
     tolerance = _checks.number("tolerance", tolerance, low=0.0, low_open=True, high=MAX_TOLERANCE)
@@ -419,7 +454,14 @@ def plan_validation(
         tolerance=float(tolerance),
         max_iter=int(max_iter),
         loads=resolve_loads(loads, p_top),
+        engine=solver.name,
+        device=_device_name(device),
     )
+
+
+def _device_name(device: Any) -> str:
+    """The device as text (a plan travels to workers, which resolve it themselves)."""
+    return device.strip().lower() if isinstance(device, str) else str(device)
 
 
 def check_jobs(jobs: int) -> int:
@@ -442,15 +484,18 @@ def validate_design(
     max_iter: int = MAX_ITER,
     name: str = "design",
     progress: Callable[[int], Any] | None = None,
+    engine: str = DEFAULT_ENGINE,
+    device: str = "auto",
 ) -> ValidationResult:
-    """BEM (Tamaas) against the forward ``model`` (default: independent) for one design.
+    """BEM against the forward ``model`` (default: independent) for one design.
 
     grid: M points per side (default 256 n), a multiple of n. loads: K uniform pressures up
     to P*_max (reached at Delta_max), or explicit P* values in (0, P*_max]. jobs: processes;
     the load path is split into ``jobs`` contiguous warm-started chunks. progress(n) is
-    called as loads finish. Raises MetainterfaceError on bad input or non-convergence.
+    called as loads finish. engine: "torch" (default; ``device`` "auto", "cpu", "cuda" or
+    "cuda:N") or "tamaas" (the ``bem`` extra). Raises MetainterfaceError on bad input or
+    non-convergence.
     """
-    require_tamaas()
     jobs = check_jobs(jobs)
     prep = plan_validation(
         design,
@@ -460,6 +505,8 @@ def validate_design(
         model=model,
         tolerance=tolerance,
         max_iter=max_iter,
+        engine=engine,
+        device=device,
     )
     return prep.solve(jobs, progress)
 
@@ -471,8 +518,11 @@ def validation_request(
     model: ForwardModel,
     tolerance: float,
     max_iter: int,
+    *,
+    engine: str = DEFAULT_ENGINE,
 ) -> dict[str, Any]:
-    """What a stored result must match to be reused on resume (JSON-normalised)."""
+    """What a stored result must match to be reused on resume (JSON-normalised); the
+    engine is part of it, so a resumed sweep never mixes two engines' results."""
     core = {k: v for k, v in design.to_dict().items() if k != "provenance"}
     request = {
         "design": core,
@@ -482,5 +532,6 @@ def validation_request(
         "tolerance": float(tolerance),
         "max_iter": int(max_iter),
         "area": AREA_ESTIMATE,
+        "engine": engine,
     }
     return json.loads(json.dumps(request, default=str))
