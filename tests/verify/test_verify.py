@@ -152,3 +152,23 @@ def test_cli_no_verify_and_bad_options(tmp_path, capsys):
     assert err.count("\n") == 1 and "--verify-grid must be a multiple" in err
     assert main([*bad[:-2], "--max-bem-error", "150"]) == 2
     assert "--max-bem-error must be a percentage" in capsys.readouterr().err
+
+
+def test_the_engine_and_device_reach_the_solver_and_fail_early(unchecked):
+    s = Verify(grid=96, loads=3, engine="tamaas")
+    tam = bem_check(unchecked.design, unchecked.target, s, unchecked.model)
+    ours = bem_check(unchecked.design, unchecked.target, Verify(grid=96, loads=3, device="cpu"))
+    assert (tam.engine, tam.device) == ("tamaas", "cpu") and (ours.engine, ours.device) == (
+        "torch",
+        "cpu",
+    )
+    np.testing.assert_allclose(ours.alpha_bem, tam.alpha_bem, rtol=1e-6)
+    with pytest.raises(mi.MetainterfaceError, match="device"):
+        mi.design("bilinear", verify=Verify(device="tpu"), method="hertz", refine=False)
+
+
+def test_cli_engine_option_names_itself(tmp_path, capsys):
+    args = ["design", "--target", "bilinear", "--out", str(tmp_path), "--verify-engine", "fem"]
+    with pytest.raises(SystemExit) as done:  # argparse's own one-line error
+        main(args)
+    assert done.value.code == 2 and "--verify-engine" in capsys.readouterr().err

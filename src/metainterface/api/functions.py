@@ -222,8 +222,8 @@ def design(
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
     fm = get_model(model)
     checks = as_verify(verify)
-    if checks is not None:  # a bad grid fails now, not after the design
-        checks.grid_for(settings or CellSettings())
+    if checks is not None:  # a bad grid or device fails now, not after the design
+        checks.ready(settings or CellSettings())
     limit = _limit(max_pressure, modulus)
     extra_loss = None
     if limit is not None:

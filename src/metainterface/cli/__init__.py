@@ -46,6 +46,7 @@ OPTION_NAMES = {
         "surrogate": "--model",
         "grid": "--verify-grid",
         "loads": "--verify-loads",
+        "engine": "--verify-engine",
     },
     "curve": {"model": "--physics"},
     "validate": {"model": "--physics"},

@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import argparse
 
-from metainterface._names import DEFAULT_MODEL, METHOD_NAMES, MODEL_NAMES
+from metainterface._names import (
+    DEFAULT_ENGINE,
+    DEFAULT_MODEL,
+    ENGINE_NAMES,
+    METHOD_NAMES,
+    MODEL_NAMES,
+)
 from metainterface.cli.common import positive_int
 
 
@@ -166,6 +172,19 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="BEM error a design is trusted within, in per cent (default 2): above it the "
         "summary says so and the exit status is 3",
     )
+    check.add_argument(
+        "--verify-engine",
+        choices=ENGINE_NAMES,
+        default=DEFAULT_ENGINE,
+        help="contact solver of the check: torch (default; CPU threads or a GPU) or tamaas "
+        "(the [bem] extra, the reference)",
+    )
+    check.add_argument(
+        "--device",
+        default="auto",
+        metavar="DEVICE",
+        help="where the torch BEM engine runs: auto, cpu, cuda or cuda:N",
+    )
     p.set_defaults(func=run)
 
 
@@ -310,6 +329,8 @@ def _verify(args: argparse.Namespace):
         loads=args.verify_loads,
         correct=args.correct,
         max_error=args.max_bem_error / 100,
+        engine=args.verify_engine,
+        device=args.device,
     )
 
 

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
+from metainterface._names import DEFAULT_ENGINE, ENGINE_NAMES
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings, Design
@@ -34,8 +35,6 @@ from metainterface.physics.models import ForwardModel, get_model
 GRID_PER_ASPERITY = 128
 #: Default number of loads of the check.
 DEFAULT_LOADS = 10
-#: Contact solvers the check can use.
-ENGINES = ("torch", "tamaas")
 #: Most correction iterations (each is one BEM load path).
 MAX_ITERATIONS = 20
 #: Auto correction (``correct=None``) runs when the BEM adds more than this to the model's
@@ -77,7 +76,7 @@ class Verify:
     correct: bool | None = None
     iterations: int = 3
     max_error: float = 0.02
-    engine: str = "torch"
+    engine: str = DEFAULT_ENGINE
     device: str = "auto"
 
     def __post_init__(self) -> None:
@@ -91,12 +90,20 @@ class Verify:
             )
         _checks.whole("iterations", self.iterations, low=1, high=MAX_ITERATIONS)
         _checks.number("max_error", self.max_error, low=0.0, low_open=True, high=1.0)
-        _checks.choice("engine", self.engine, ENGINES)
+        _checks.choice("engine", self.engine, ENGINE_NAMES)
         if not isinstance(self.device, str):
             raise MetainterfaceError(
                 f"device must be 'auto', 'cpu', 'cuda' or 'cuda:N', got {self.device!r}",
                 argument="device",
             )
+
+    def ready(self, cell: CellSettings) -> None:
+        """Check what only the run can tell, before any work: the grid against the cell, the
+        engine installed (Tamaas) and the device seen by torch. One-line errors."""
+        from metainterface.validation.engines import check_engine
+
+        self.grid_for(cell)
+        check_engine(self.engine, self.device)
 
     def grid_for(self, cell: CellSettings) -> int:
         """The check's grid for this cell (checked against it)."""
@@ -229,19 +236,22 @@ def solve_bem(design: Design, loads: np.ndarray, settings: Verify, model: Forwar
 
     Raises MetainterfaceError if a solve does not converge.
     """
-    from metainterface.validation import plan_validation, require_tamaas
+    from metainterface._device import resolve_device
+    from metainterface.validation import plan_validation
 
-    require_tamaas()
     grid = settings.grid_for(design.settings)
-    plan = plan_validation(design, grid=grid, loads=loads, model=model)
+    plan = plan_validation(
+        design, grid=grid, loads=loads, model=model, engine=settings.engine, device=settings.device
+    )
+    device = str(resolve_device(settings.device)) if settings.engine == "torch" else "cpu"
     t0 = time.perf_counter()
     result = plan.solve(1)
     return Solved(
         alpha_bem=np.asarray(result.alpha_bem, dtype=np.float64),
         alpha_model=np.asarray(result.alpha_model, dtype=np.float64),
         grid=grid,
-        engine="tamaas",
-        device="cpu",
+        engine=plan.engine,
+        device=device,
         seconds=time.perf_counter() - t0,
     )
 
