@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
+from metainterface._device import resolve_device
 from metainterface._files import check_output_file, check_output_folder, output_set
 from metainterface.api.results import CURVE_STEPS, Curve, DesignResult, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
@@ -122,6 +123,7 @@ def design(
     scale_sigma: float = 0.0,
     robust_samples: int = 16,
     z_step: float | str | None = None,
+    device: str = "auto",
     verify: bool | Verify = True,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target, checked in BEM.
@@ -188,6 +190,11 @@ def design(
         gammas re-refined with the heights fixed. A plain number in units of R, or a length
         ('1um') with ``radius``; at most Delta_max. ``result.printable`` reports the error
         before the snap, after it and after the re-refine.
+    device : str
+        Where the refinement (and the BEM check, with ``verify=True``) runs: ``"auto"``
+        (CUDA when torch sees it, else the CPU), ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
+        Every target's starts go in one batch; the starts are drawn on the CPU, so a seed
+        gives the same starts on every device.
     verify : bool or Verify
         Check each design in the boundary element method and report its error to the
         target there (``result.bem_error``, ``result.bem``), correcting it in BEM where the
@@ -211,9 +218,8 @@ def design(
     if settings is not None and not isinstance(settings, CellSettings):
         raise MetainterfaceError("settings must be a CellSettings")
     n = (settings or CellSettings()).n_asperities
-    _checks.affordable(
-        "starts", starts, (starts + hedge + fallback) * len(items) * n * BYTES_PER_START
-    )
+    dev = resolve_device(device)
+    _affordable_rows(method, starts, hedge, fallback, len(items), n, dev)
     if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
         raise MetainterfaceError("refine_settings must be a RefineSettings")
     if not isinstance(refine, bool):
@@ -221,7 +227,7 @@ def design(
     if not isinstance(full_target, bool):
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
     fm = get_model(model)
-    checks = as_verify(verify)
+    checks = as_verify(verify, device)
     if checks is not None:  # a bad grid or device fails now, not after the design
         checks.ready(settings or CellSettings())
     limit = _limit(max_pressure, modulus)
@@ -250,10 +256,11 @@ def design(
         fallback=fallback if method == "surrogate" else 0,
         perturb=perturb,
         z_step=step,
+        device=dev,
     )
     results = [_public(r, limit, modulus) for r in raw]
     if perturb is not None:
-        results = [_robust_stats(r, perturb, seed) for r in results]
+        results = [_robust_stats(r, perturb, seed, dev) for r in results]
     if step is not None:
         results = [_printable_record(r, radius_m) for r in results]
     if checks is not None:
@@ -265,6 +272,32 @@ def design(
         folders = [out] if single else [out / r.target.name for r in results]
         _save_all(results, folders, physical, meta, full_target)
     return results[0] if single else results
+
+
+def _affordable_rows(
+    method: str, starts: int, hedge: int, fallback: int, targets: int, n: int, device: Any
+) -> None:
+    """Refuse a design whose largest batch would not fit in memory (the GPU's on CUDA).
+
+    The rows refined together: ``starts`` per target by multistart and Hertz; by the
+    surrogate, 1 + ``hedge`` per target, then ``fallback`` per target for the targets it
+    missed, in a batch of its own after the first is freed (so the larger of the two, not
+    their sum)."""
+    per_target = starts if method != "surrogate" else max(1 + hedge, fallback)
+    nbytes = per_target * targets * n * BYTES_PER_START
+    what = f" for {targets} targets" if targets > 1 else ""
+    if device.type != "cuda":
+        _checks.affordable("starts", starts, nbytes, what=what)
+        return
+    import torch
+
+    total = torch.cuda.get_device_properties(device).total_memory
+    if nbytes > _checks.MEMORY_SHARE * total:
+        raise MetainterfaceError(
+            f"starts = {starts} would need about {nbytes / 2**30:.1f} GiB on {device}{what}, "
+            f"more than half its {total / 2**30:.1f} GiB; design fewer targets per call",
+            argument="starts",
+        )
 
 
 #: Made cells drawn to report a robust design's error distribution (independent of the
@@ -308,7 +341,9 @@ def _manufacturing(
     return perturb, step, radius_m
 
 
-def _robust_stats(r: DesignResult, perturb: Perturbation, seed: int) -> DesignResult:
+def _robust_stats(
+    r: DesignResult, perturb: Perturbation, seed: int, device: Any = None
+) -> DesignResult:
     """The result with ``robust``: its nominal error and the distribution of the error of
     made cells (independent draws), beside the rms error it was refined against."""
     from metainterface.inverse.tolerance import spread
@@ -330,6 +365,7 @@ def _robust_stats(r: DesignResult, perturb: Perturbation, seed: int) -> DesignRe
         check,
         target=(r.target.p_star, r.target.alpha),
         linear=False,
+        device=device,
     )
     stats = {
         "sigma_h": perturb.sigma_h,
@@ -527,6 +563,7 @@ def curve(
     model: str | ForwardModel | None = None,
     steps: int = CURVE_STEPS,
     smooth: float | None = None,
+    device: str = "auto",
 ) -> Curve:
     """The alpha(P*) and S*(P*) curve of a design along Delta in [0, Delta_max].
 
@@ -544,6 +581,8 @@ def curve(
         Delta samples, in [2, 1000000].
     smooth : float
         Softplus steepness kappa_s [1/R] instead of the exact bracket, in [1, 1e15].
+    device : str
+        Where the sweep runs: ``"auto"``, ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
 
     Returns
     -------
@@ -554,7 +593,8 @@ def curve(
     steps = _checks.whole("steps", steps, low=2, high=MAX_STEPS)
     if smooth is not None:
         smooth = _checks.number("smooth", smooth, low=SMOOTH_RANGE[0], high=SMOOTH_RANGE[1])
-    return design_curve(d, model, steps=steps, smooth=smooth)
+    dev = resolve_device(device)
+    return design_curve(d, model, steps=steps, smooth=smooth, device=dev)
 
 
 def export(

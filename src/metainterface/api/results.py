@@ -124,26 +124,32 @@ def design_curve(
     steps: int = CURVE_STEPS,
     smooth: float | None = None,
     resolve_engagement: bool = False,
+    device: torch.device | None = None,
 ) -> Curve:
     """The :class:`Curve` of a design under a forward model (float64, no gradients).
 
     resolve_engagement: add Delta samples clustered geometrically just after each asperity
     touches (Delta = h_i), where S* dips towards 0 over a tiny range of Delta that a uniform
     sweep samples at random depths (for figures: S* then draws as clean cusps, not spikes).
+    device: where the sweep runs (default the CPU); the curve is numpy.
     """
     m = get_model(model)
+    dev = device or torch.device("cpu")
     with torch.no_grad():
         if resolve_engagement:
-            delta = torch.as_tensor(_engagement_grid(design, steps))
+            delta = torch.as_tensor(_engagement_grid(design, steps), device=dev)
             sw = m.sweep(
-                torch.as_tensor(design.gamma)[None],
-                torch.as_tensor(design.h)[None],
+                torch.as_tensor(design.gamma, device=dev)[None],
+                torch.as_tensor(design.h, device=dev)[None],
                 design.settings,
                 smooth=smooth,
                 delta=delta,
             )
-        else:
+        elif dev.type == "cpu":
             sw = m.design_sweep(design, n_delta=steps, smooth=smooth)
+        else:  # design_sweep's tensors, on the device
+            gamma, h = (t.to(dev) for t in design.tensors(torch.float64))
+            sw = m.sweep(gamma, h, design.settings, smooth=smooth, n_delta=steps)
     delta = sw.delta if sw.delta.dim() == 1 else sw.delta[0]
     for name in ("p_star", "alpha", "stiffness"):
         if not torch.isfinite(getattr(sw, name)[0]).all():
@@ -153,10 +159,10 @@ def design_curve(
                 + "; the curve would be wrong, so none is returned"
             )
     return Curve(
-        delta=delta.numpy().copy(),
-        p_star=sw.p_star[0].numpy().copy(),
-        alpha=sw.alpha[0].numpy().copy(),
-        stiffness=sw.stiffness[0].numpy().copy(),
+        delta=delta.cpu().numpy().copy(),
+        p_star=sw.p_star[0].cpu().numpy().copy(),
+        alpha=sw.alpha[0].cpu().numpy().copy(),
+        stiffness=sw.stiffness[0].cpu().numpy().copy(),
         model=m.label,
         notes=idle_notes(design),
     )

@@ -21,6 +21,7 @@ import numpy as np
 import torch
 
 from metainterface import _checks
+from metainterface._device import resolve_device
 from metainterface._files import provenance, strict_json, write_columns, write_text
 from metainterface.api.results import DesignResult, shown
 from metainterface.errors import MetainterfaceError
@@ -325,6 +326,7 @@ def tolerance(
     modulus: str | float | None = None,
     out: str | os.PathLike[str] | None = None,
     option_names: dict[str, str] | None = None,
+    device: str = "auto",
 ) -> ToleranceResult:
     """The spread of a design's alpha(P*) and of its error under manufacturing errors.
 
@@ -365,6 +367,10 @@ def tolerance(
         Write band.csv, tolerance.json and tolerance.png into this folder.
     option_names : dict
         The names bad-input errors give the options (the CLI passes its ``--options``).
+    device : str
+        Where the made cells are evaluated: ``"auto"`` (CUDA when torch sees it), ``"cpu"``,
+        ``"cuda"`` or ``"cuda:N"``. The draws are made on the CPU: a seed gives the same
+        made cells on every device.
 
     Returns
     -------
@@ -378,6 +384,7 @@ def tolerance(
     s_s = _checks.number(names["scale_sigma"], scale_sigma, low=0.0, high=0.5)
     tau = _stress(shear_strength, d, ("shear_strength_pa",), names["shear_strength"])
     e_star = _stress(modulus, d, ("e_star_pa",), names["modulus"])
+    dev = resolve_device(device)
     t0 = time.perf_counter()
     pert = Perturbation.draw(
         d.n_asperities, samples, seed, sigma_h=s_h, sigma_gamma=s_g, scale_sigma=s_s
@@ -389,6 +396,7 @@ def tolerance(
         fm,
         pert,
         target=None if ref is None else (ref.p_star, ref.alpha),
+        device=dev,
     )
     lo, mid, hi = np.quantile(sp.alpha, [0.05, 0.5, 0.95], axis=0)
     half = tol.Z95 * sp.linear_sd
@@ -498,6 +506,7 @@ def min_radius(
     target: Target | str | None = None,
     option_names: dict[str, str] | None = None,
     progress: bool = False,
+    device: str = "auto",
 ) -> PrinterSizing:
     """What printer a design needs: the smallest asperity radius R at which a printer's
     absolute height error keeps the p95 relative curve error within ``max_error``.
@@ -519,6 +528,8 @@ def min_radius(
         As in :func:`tolerance` (fewer samples by default: about 30 probes are run).
     progress : bool
         Show a progress bar of the probes (on stderr, once the search takes over 2 s).
+    device : str
+        Where the probes run, as in :func:`tolerance`.
 
     Returns
     -------
@@ -531,6 +542,7 @@ def min_radius(
     budget = _max_error(max_error, names["max_error"])
     s_g = _checks.number(names["sigma_gamma"], sigma_gamma, low=0.0)
     s_s = _checks.number(names["scale_sigma"], scale_sigma, low=0.0, high=0.5)
+    dev = resolve_device(device)
     pert = Perturbation.draw(
         d.n_asperities, samples, seed, sigma_h=0.0, sigma_gamma=s_g, scale_sigma=s_s
     )
@@ -556,6 +568,7 @@ def min_radius(
             target=None if ref is None else (ref.p_star, ref.alpha),
             iterations=tol.SEARCH_STEPS,
             progress=bar.update,
+            device=dev,
         )
     radius_m = math.inf if s_h == 0.0 else sigma_m / s_h  # s_h = inf: any R (0)
     unit = radius_m / d.settings.radius

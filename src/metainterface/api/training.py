@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from metainterface import _checks
+from metainterface._device import resolve_device
 from metainterface._files import check_output_file, check_output_folder
 from metainterface.data import generate_dataset as _generate
 from metainterface.data import load_dataset
@@ -32,13 +33,17 @@ def generate_dataset(
     settings: CellSettings | None = None,
     progress: bool = True,
     chunk: int = DEFAULT_CHUNK,
+    device: str = "auto",
 ) -> GenerationReport:
     """Generate a training dataset: ``samples`` designs of the paper's six topography
     categories with their exact normalised curves, split 80/10/10, written atomically to
     ``out`` (.npz). The same (samples, seed, settings) give the same arrays; ``chunk``
-    (samples computed together) changes memory, not results."""
+    (samples computed together) changes memory, not results. ``device`` ("auto", "cpu",
+    "cuda", "cuda:N") computes the curves there ("auto": CUDA when torch sees it); the same
+    seed gives the same arrays on one device (docs: concepts/devices)."""
     samples = _checks.whole("samples", samples, low=1, high=MAX_SAMPLES)
     seed = _checks.seed(seed)
+    dev = resolve_device(device)
     chunk = _checks.whole("chunk", chunk, low=1, high=1_000_000)
     settings = settings or CellSettings()
     out = check_output_file(out)
@@ -46,7 +51,7 @@ def generate_dataset(
     _checks.disk_room("samples", samples, samples * row, out.parent)
     # a chunk's curves, in flight on a few threads, with the sweep's working arrays
     _checks.affordable("chunk", chunk, 8 * chunk * row)
-    return _generate(samples, seed, settings, out, progress=progress, chunk=chunk)
+    return _generate(samples, seed, settings, out, progress=progress, chunk=chunk, device=dev)
 
 
 def train_surrogate(
@@ -56,10 +61,14 @@ def train_surrogate(
     *,
     resume: bool = False,
     progress: bool = True,
+    device: str = "auto",
 ) -> TrainResult:
     """Train the inverse network on a dataset (``generate_dataset``) into the run folder
     ``out``: one atomic checkpoint per epoch (``resume=True`` continues), the best model as
-    ``out/model.pt``, usable as ``design(..., surrogate=out / "model.pt")``."""
+    ``out/model.pt``, usable as ``design(..., surrogate=out / "model.pt")``. ``device``
+    ("auto", "cpu", "cuda", "cuda:N") is where the model and the dataset live while it
+    trains; the files load on any device (a run may be resumed on another one)."""
+    dev = resolve_device(device)
     check_output_folder(out)
     ds = load_dataset(dataset)
     fingerprint = hashlib.sha256(json.dumps(ds.meta, sort_keys=True).encode()).hexdigest()[:16]
@@ -71,6 +80,7 @@ def train_surrogate(
         config,
         resume=resume,
         progress=progress,
+        device=dev,
         dataset_info={
             "path": str(dataset),
             "samples": len(ds),

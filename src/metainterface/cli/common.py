@@ -27,11 +27,11 @@ def positive_float(text: str) -> float:
 
 
 def add_device(parser: argparse.ArgumentParser) -> None:
-    """``--device``: where torch runs, resolved (and refused in one line) by the library's
-    ``resolve_device``."""
+    """``--device``: where the command's torch work runs, checked by the library
+    (``metainterface._device.resolve_device``) so the values and errors match the API's."""
     parser.add_argument(
         "--device",
         default="auto",
         metavar="DEVICE",
-        help="auto, cpu, cuda or cuda:N",
+        help="auto, cpu, cuda or cuda:N (default auto: CUDA when torch sees it, else the CPU)",
     )

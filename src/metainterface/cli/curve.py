@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
-from metainterface.cli.common import positive_float, positive_int
+from metainterface.cli.common import add_device, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,6 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--out", required=True, help="output CSV")
     p.add_argument("--plot", help="also draw alpha(P*) and S*(P*) to this PNG/PDF")
+    add_device(p)
     p.set_defaults(func=run)
 
 
@@ -41,7 +42,9 @@ def run(args: argparse.Namespace) -> int:
     import metainterface as mi
     from metainterface._files import write_columns
 
-    c = mi.curve(args.design, model=args.physics, steps=args.steps, smooth=args.smooth)
+    c = mi.curve(
+        args.design, model=args.physics, steps=args.steps, smooth=args.smooth, device=args.device
+    )
     write_columns(
         args.out,
         c.columns(),

@@ -11,7 +11,7 @@ from metainterface._names import (
     METHOD_NAMES,
     MODEL_NAMES,
 )
-from metainterface.cli.common import positive_int
+from metainterface.cli.common import add_device, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -132,6 +132,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--max-pressure",
         help="peak contact pressure limit: p/E* (number) or a stress with --modulus",
     )
+    add_device(p)
     check = p.add_argument_group(
         "BEM check (on by default; docs: concepts/verification)",
         "each design is solved in BEM at --verify-loads loads over the target's range and "
@@ -178,12 +179,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=DEFAULT_ENGINE,
         help="contact solver of the check: torch (default; CPU threads or a GPU) or tamaas "
         "(the [bem] extra, the reference)",
-    )
-    check.add_argument(
-        "--device",
-        default="auto",
-        metavar="DEVICE",
-        help="where the torch BEM engine runs: auto, cpu, cuda or cuda:N",
     )
     p.set_defaults(func=run)
 
@@ -242,6 +237,7 @@ def run(args: argparse.Namespace) -> int:
         settings=_settings(args),
         meta=_command(args),
         full_target=args.full_target,
+        device=args.device,
         verify=_verify(args),
         **_manufacturing(args),
     )

@@ -6,6 +6,7 @@ import argparse
 import math
 from pathlib import Path
 
+from metainterface.cli.common import add_device
 from metainterface.errors import MetainterfaceError
 
 _FIGURE_SUFFIXES = (".png", ".pdf", ".svg")  # what plots.save_figure writes
@@ -39,6 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="samples processed at once (default 4096; memory only, results do not depend on it)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_device(p)
     p.set_defaults(func=run)
 
 
@@ -86,7 +88,13 @@ def run(args: argparse.Namespace) -> int:
         )
 
     report = mi.generate_dataset(
-        samples, args.out, seed=seed, settings=settings, progress=not args.quiet, chunk=chunk
+        samples,
+        args.out,
+        seed=seed,
+        settings=settings,
+        progress=not args.quiet,
+        chunk=chunk,
+        device=args.device,
     )
     if args.plot is not None:
         from metainterface.plots import plot_dataset_examples, save_figure

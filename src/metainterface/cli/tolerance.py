@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
+from metainterface.cli.common import add_device
 
 #: How the library's errors name the options: as typed on the command line.
 OPTION_NAMES = {
@@ -79,6 +80,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     sizing.add_argument("--max-error", help="p95 error budget, e.g. 5%% or 0.05")
     p.add_argument("--out", required=True, help="output folder")
+    add_device(p)
     p.set_defaults(func=run)
 
 
@@ -92,6 +94,7 @@ def run(args: argparse.Namespace) -> int:
         model=args.model,
         target=args.target,
         option_names=OPTION_NAMES,
+        device=args.device,
     )
     printer = None
     radius, sigma_h = args.radius, args.sigma_h

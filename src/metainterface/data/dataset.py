@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from metainterface._device import resolve_device
 from metainterface._files.atomic import atomic_open, ensure_parent
 from metainterface._files.provenance import provenance
 from metainterface.data.categories import CATEGORIES, CATEGORY_NAMES
@@ -254,6 +255,7 @@ def generate_dataset(
     params: Mapping[str, Any] | None = None,
     examples: int = 3,
     workers: int | None = None,
+    device: str | torch.device = "cpu",
 ) -> GenerationReport:
     """Generate ``samples`` designs of the six categories with their exact curves into ``out``.
 
@@ -271,6 +273,10 @@ def generate_dataset(
     examples: test-split rows per category kept in the report for figures.
     workers: threads computing curves side by side, each with one torch thread; default
         min(4, torch.get_num_threads()). Results do not depend on it.
+    device: where the curves are computed ("auto", "cpu", "cuda", "cuda:N"). On a GPU each
+        chunk goes in one piece, from one worker thread (the next chunk is sampled on the
+        CPU meanwhile); float reductions there round differently from the CPU's, so a seed
+        gives the same arrays on one device, equal to float32 rounding across devices.
     Curves use the exact Macaulay bracket, computed in float32 by ``curves_numpy``.
     """
     if not isinstance(settings, CellSettings):
@@ -282,6 +288,11 @@ def generate_dataset(
     examples = _whole("examples", examples, 0)
     workers = min(4, torch.get_num_threads()) if workers is None else workers
     workers = _whole("workers", workers, 1)
+    dev = resolve_device(device)
+    # the CPU's curves go in cache-sized pieces over several threads; a GPU takes a chunk whole
+    curve_chunk = _CURVE_CHUNK if dev.type == "cpu" else chunk
+    if dev.type != "cpu":
+        workers = 1
     cat_params = _category_params(params)
     started = time.perf_counter()
 
@@ -370,7 +381,9 @@ def generate_dataset(
             with _curve_pool(workers) as pool:
                 for cat, gamma, h in _rechunk(blocks, chunk):
                     gamma, h = sort_and_anchor(gamma, h)
-                    job = pool.submit(curves_numpy, gamma, h, settings, chunk_size=_CURVE_CHUNK)
+                    job = pool.submit(
+                        curves_numpy, gamma, h, settings, chunk_size=curve_chunk, device=dev
+                    )
                     in_flight.append((cat, gamma, h, job))
                     while len(in_flight) > workers:  # keep the workers busy, memory bounded
                         emit(*in_flight.popleft())

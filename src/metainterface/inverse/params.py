@@ -58,7 +58,9 @@ class Parameterisation:
         n = settings.n_asperities
         if self.fixed_gamma is not None:
             r_h = raw
-            gamma = torch.full((raw.shape[0], n), float(self.fixed_gamma), dtype=raw.dtype)
+            gamma = torch.full(
+                (raw.shape[0], n), float(self.fixed_gamma), dtype=raw.dtype, device=raw.device
+            )
         else:
             r_g, r_h = raw[:, :n], raw[:, n:]
             span = settings.gamma_max - settings.gamma_min

@@ -65,17 +65,24 @@ class Perturbation:
     def samples(self) -> int:
         return self.z.shape[0]
 
+    def to(self, device: torch.device) -> Perturbation:
+        """The same draws on ``device`` (they are always drawn on the CPU: the same seed gives
+        the same made cells on every device)."""
+        return Perturbation(self.sigma_h, self.sigma_gamma, self.scale_sigma, self.z.to(device))
+
     def scales(self, n: int) -> Tensor:
-        """(2N + 1,) the standard deviation of each column of ``z``."""
+        """(2N + 1,) the standard deviation of each column of ``z`` (on its device)."""
         return torch.tensor(
-            [self.sigma_gamma] * n + [self.sigma_h] * n + [self.scale_sigma], dtype=DTYPE
+            [self.sigma_gamma] * n + [self.sigma_h] * n + [self.scale_sigma],
+            dtype=DTYPE,
+            device=self.z.device,
         )
 
     def apply(self, gamma: Tensor, h: Tensor, *, clip: bool = True) -> tuple[Tensor, Tensor]:
         """Perturbed copies of (B, N) designs: (B S, N) each, design b's copies in rows
         b S ... b S + S - 1 (the same normals for every design: common random numbers)."""
         n = gamma.shape[-1]
-        z = self.z.to(gamma.dtype)
+        z = self.z.to(dtype=gamma.dtype, device=gamma.device)
         g = gamma[:, None, :] + self.sigma_gamma * z[None, :, :n]
         if clip:
             g = g.clamp_min(GAMMA_FLOOR)
@@ -86,7 +93,7 @@ class Perturbation:
     def clipped(self, gamma: Tensor) -> float:
         """The fraction of sampled gammas of the (1, N) design that were clipped."""
         n = gamma.shape[-1]
-        raw = gamma + self.sigma_gamma * self.z[:, :n].to(gamma.dtype)
+        raw = gamma + self.sigma_gamma * self.z[:, :n].to(dtype=gamma.dtype, device=gamma.device)
         return float((raw < GAMMA_FLOOR).to(DTYPE).mean())
 
 

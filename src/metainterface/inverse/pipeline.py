@@ -21,6 +21,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from metainterface._device import resolve_device
 from metainterface._names import METHOD_NAMES
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.params import (
@@ -153,6 +154,7 @@ def design(
     fallback_error: float = 0.02,
     perturb: Perturbation | None = None,
     z_step: float | None = None,
+    device: str | torch.device = "cpu",
 ) -> list[DesignResult]:
     """Design one cell per target with ``method``; returns one result per target.
 
@@ -186,8 +188,14 @@ def design(
     multiples of it (anchored at 0), then its gammas re-refined with the heights fixed
     (:class:`~metainterface.inverse.params.FixedHeights`, the polish on the exact law);
     ``quantisation`` records the error before the snap, after it and after the re-refine.
+
+    ``device`` ("auto", "cpu", "cuda", "cuda:N"): where the refinement runs, every target's
+    starts in one batch. The starts, the surrogate's prediction and the perturbations are
+    made on the CPU whatever the device (the same seed, the same starts everywhere); the
+    results are numpy.
     """
     model = get_model(model)
+    dev = resolve_device(device)
     common = dict(
         refine_designs=refine_designs,
         settings=settings,
@@ -198,6 +206,7 @@ def design(
         extra_loss=extra_loss,
         model=model,
         perturb=perturb,
+        device=dev,
     )
     method, notes = _usable_method(method, settings, model_path)
     if notes:
@@ -227,7 +236,7 @@ def design(
             results[i] = replace(r, seconds=r.seconds + extra)
     if z_step is not None:
         results = printable(
-            results, z_step, refine_settings or RefineSettings(), extra_loss, model, perturb
+            results, z_step, refine_settings or RefineSettings(), extra_loss, model, perturb, dev
         )
     return results
 
@@ -244,17 +253,23 @@ def printable(
     extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None,
     model: ForwardModel,
     perturb: Perturbation | None = None,
+    device: torch.device | None = None,
 ) -> list[DesignResult]:
     """The designs with heights on multiples of ``step`` [units of R] and their gammas
-    re-refined (all targets in one batch); the better of the snapped and the re-refined
-    design is kept, by the robust error when ``perturb`` is given."""
+    re-refined (all targets in one batch, on ``device``, default the CPU); the better of
+    the snapped and the re-refined design is kept, by the robust error when ``perturb`` is
+    given."""
     t0 = time.perf_counter()
+    dev = device or torch.device("cpu")
     settings = results[0].settings
     grid = TargetGrid.from_curves(
         [(r.target.p_star, r.target.alpha) for r in results], rs.grid_points
-    )
-    gamma = torch.as_tensor(np.array([r.gamma for r in results]), dtype=DTYPE)
-    h = snap_heights(torch.as_tensor(np.array([r.h for r in results]), dtype=DTYPE), step)
+    ).to(dev)
+    gamma = torch.as_tensor(np.array([r.gamma for r in results]), dtype=DTYPE, device=dev)
+    h = torch.as_tensor(np.array([r.h for r in results]), dtype=DTYPE, device=dev)
+    h = snap_heights(h, step)
+    if perturb is not None:
+        perturb = perturb.to(dev)
     param = FixedHeights(h=h)
     snapped = relative_error(gamma, h, settings, grid, model)
     raw = polish(
@@ -271,6 +286,9 @@ def printable(
     g_best = torch.where(better[:, None], g_new, gamma)
     err = torch.where(better, after, snapped)
     rob = torch.where(better, score_new, score_old) if perturb is not None else None
+    # one copy to the host for all targets (it waits for the device)
+    g_best, h, err, snapped = g_best.cpu(), h.cpu(), err.cpu(), snapped.cpu()
+    rob = None if rob is None else rob.cpu()
     extra = (time.perf_counter() - t0) / len(results)
     out = []
     for i, r in enumerate(results):
@@ -283,8 +301,8 @@ def printable(
         out.append(
             replace(
                 r,
-                gamma=g_best[i].numpy().copy(),
-                h=h[i].numpy().copy(),
+                gamma=g_best[i].cpu().numpy().copy(),
+                h=h[i].cpu().numpy().copy(),
                 error=float(err[i]),
                 robust_error=None if rob is None else float(rob[i]),
                 quantisation=q,
@@ -308,7 +326,9 @@ def _design(
     model: ForwardModel,
     hedge: int,
     perturb: Perturbation | None = None,
+    device: torch.device | None = None,
 ) -> list[DesignResult]:
+    dev = device or torch.device("cpu")
     if method not in METHODS:
         raise MetainterfaceError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     if starts < 1:
@@ -334,8 +354,12 @@ def _design(
         gamma0, h0 = random_starts(starts, len(targets), settings, seed, METHODS[method])
     grid = TargetGrid.from_curves(
         [(t.p_star, t.alpha) for t in targets], refine_settings.grid_points
-    )
-    rows = grid.rows(torch.arange(len(targets)).repeat_interleave(per_target))
+    ).to(dev)
+    # made on the CPU (seeded generators, the network), refined on the device
+    gamma0, h0 = gamma0.to(dev), h0.to(dev)
+    if perturb is not None:
+        perturb = perturb.to(dev)
+    rows = grid.rows(torch.arange(len(targets), device=dev).repeat_interleave(per_target))
     # the error of the starts as given (the refinement starts a little inside the bounds)
     param = METHODS[method]
     err0 = relative_error(gamma0, h0, settings, rows, model)
@@ -350,7 +374,7 @@ def _design(
         return nominal if perturb is None else robust_error(g, hh, settings, grid, perturb, model)
 
     rank = score(gamma, h, rows, err)
-    offset = torch.arange(len(targets))[:, None] * per_target
+    offset = torch.arange(len(targets), device=dev)[:, None] * per_target
     if refine_designs and refine_settings.polish_iterations > 0:
         # The early stops cut the search short on every row; the best few of each target get
         # to finish (rows close before the polish can swap places after it).
@@ -374,6 +398,9 @@ def _design(
     err0 = err0.view(len(targets), per_target)
     # the zero-shot error of the surrogate is its own row's; baselines report their best start
     first = err0[:, 0] if method == "surrogate" else err0.min(-1).values
+    # one copy to the host for all targets, not one per result (it waits for the device)
+    gamma, h, err, rank = gamma.detach().cpu(), h.detach().cpu(), err.cpu(), rank.cpu()
+    winner, best, first = winner.cpu(), best.cpu(), first.cpu()
     seconds = (time.perf_counter() - t0) / len(targets)
     return [
         DesignResult(

@@ -141,6 +141,10 @@ class TargetGrid:
     def rows(self, index: Tensor) -> TargetGrid:
         return TargetGrid(self.p[index], self.alpha[index])
 
+    def to(self, device: torch.device) -> TargetGrid:
+        """The grid on ``device``."""
+        return TargetGrid(self.p.to(device), self.alpha.to(device))
+
 
 def masked_loss(
     gamma: Tensor,
@@ -283,7 +287,7 @@ def robust_error(
     undershoot weight)."""
     k = perturb.samples
     g_k, h_k = perturb.apply(gamma, h)
-    rows = target.rows(torch.arange(gamma.shape[0]).repeat_interleave(k))
+    rows = target.rows(torch.arange(gamma.shape[0], device=gamma.device).repeat_interleave(k))
     made = relative_error(g_k, h_k, loaded(settings), rows, model).view(-1, k)
     nominal = relative_error(gamma, h, settings, target, model)
     return (0.5 * (nominal**2 + made.pow(2).mean(-1))).sqrt()
@@ -378,7 +382,7 @@ def refine(
                 loss = masked_loss(gamma, h, settings, rows, kappa, 1.0, model)
                 k = perturb.samples
                 g_k, h_k = perturb.apply(gamma, h)
-                rows = rows.rows(torch.arange(len(idx)).repeat_interleave(k))
+                rows = rows.rows(torch.arange(len(idx), device=idx.device).repeat_interleave(k))
                 wide = loaded(settings)  # made cells load past Delta_max where they need it
                 made = masked_loss(g_k, h_k, wide, rows, kappa, rs.undershoot_weight, model)
                 loss = 0.5 * (loss + made.view(-1, k).mean(-1))

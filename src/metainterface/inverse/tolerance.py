@@ -72,9 +72,10 @@ class Spread:
 
 def band_grid(gamma: Tensor, h: Tensor, settings: CellSettings, model: ForwardModel, points: int):
     """(points,) uniform pressures on [0, P*_max] of the (1, N) nominal design."""
+    zero = torch.zeros(1, 1, dtype=DTYPE, device=gamma.device)
     with torch.no_grad():
-        _, p_max = model.alpha_at(gamma, h, settings, torch.zeros(1, 1, dtype=DTYPE), exact=True)
-    return torch.linspace(0.0, 1.0, points, dtype=DTYPE) * p_max[0]
+        _, p_max = model.alpha_at(gamma, h, settings, zero, exact=True)
+    return torch.linspace(0.0, 1.0, points, dtype=DTYPE, device=gamma.device) * p_max[0]
 
 
 def reference_grid(
@@ -88,7 +89,7 @@ def reference_grid(
     """The curve the errors are measured to, on the grid ``design`` measures on: the
     target's (p_star, alpha) if given, else the nominal design's own curve."""
     if target is not None:
-        return TargetGrid.from_curves([target], points)
+        return TargetGrid.from_curves([target], points).to(gamma.device)
     p = band_grid(gamma, h, settings, model, points)[None]
     with torch.no_grad():
         alpha, _ = model.alpha_at(gamma, h, settings, p, exact=True)
@@ -105,16 +106,20 @@ def spread(
     target: tuple[np.ndarray, np.ndarray] | None = None,
     points: int = 128,
     linear: bool = True,
+    device: torch.device | None = None,
 ) -> Spread:
     """Monte Carlo and first-order spread of one design (N,) under ``pert``.
 
     The band's pressures are ``points`` uniform ones on [0, P*_max] of the nominal design;
     the errors are :func:`~metainterface.inverse.refine.relative_error` on the reference's
     grid (the target's, or the nominal curve's). The nominal design and every sample are
-    evaluated together: one batch of S + 1 rows at the band's and the reference's pressures.
+    evaluated together: one batch of S + 1 rows at the band's and the reference's pressures,
+    on ``device`` (default the CPU; ``pert``'s draws are moved there). numpy out.
     """
-    g0 = torch.as_tensor(np.asarray(gamma), dtype=DTYPE)[None]
-    h0 = torch.as_tensor(np.asarray(h), dtype=DTYPE)[None]
+    dev = device or torch.device("cpu")
+    g0 = torch.as_tensor(np.asarray(gamma), dtype=DTYPE, device=dev)[None]
+    h0 = torch.as_tensor(np.asarray(h), dtype=DTYPE, device=dev)[None]
+    pert = pert.to(dev)
     grid = band_grid(g0, h0, settings, model, points)
     ref = reference_grid(g0, h0, settings, model, target, points)
     own_settings, settings = settings, loaded(settings)
@@ -135,13 +140,13 @@ def spread(
     # last value where it stops short), not loaded further like the made cells
     nominal = relative_error(g0, h0, own_settings, ref, model)
     out = dict(
-        p_star=grid.numpy(),
-        alpha_nominal=band[0].numpy(),
-        alpha=band[1:].numpy(),
-        errors=errors[1:].numpy(),
+        p_star=grid.cpu().numpy(),
+        alpha_nominal=band[0].cpu().numpy(),
+        alpha=band[1:].cpu().numpy(),
+        errors=errors[1:].cpu().numpy(),
         error_nominal=float(nominal[0]),
-        gamma=g_s.numpy(),
-        h=h_s.numpy(),
+        gamma=g_s.cpu().numpy(),
+        h=h_s.cpu().numpy(),
         clipped=pert.clipped(g0),
     )
     if linear:
@@ -150,8 +155,8 @@ def spread(
         norm = torch.linalg.vector_norm(ref.alpha[0])
         r0 = at_ref[0] - ref.alpha[0]
         out.update(
-            linear_sd=torch.linalg.vector_norm(jac[:m], dim=-1).numpy(),
-            linear_errors=(torch.linalg.vector_norm(lin, dim=-1) / norm).numpy(),
+            linear_sd=torch.linalg.vector_norm(jac[:m], dim=-1).cpu().numpy(),
+            linear_errors=(torch.linalg.vector_norm(lin, dim=-1) / norm).cpu().numpy(),
             linear_rms=float(torch.sqrt((r0**2).sum() + (jac[m:] ** 2).sum()) / norm),
         )
     else:
@@ -177,7 +182,7 @@ def jacobian(
     backward pass of the summed alphas gives every row (alpha at p_j depends on row j's
     copy alone). Exact law, at fixed pressure (the implicit derivative)."""
     m, n = p_star.shape[0], gamma.shape[-1]
-    u = torch.zeros((m, 2 * n + 1), dtype=DTYPE, requires_grad=True)
+    u = torch.zeros((m, 2 * n + 1), dtype=DTYPE, device=gamma.device, requires_grad=True)
     sig = pert.scales(n)
     z = u * sig
     g = gamma + z[:, :n]
@@ -196,9 +201,12 @@ def p95(
     *,
     target: tuple[np.ndarray, np.ndarray] | None = None,
     points: int = 128,
+    device: torch.device | None = None,
 ) -> float:
     """The 95th percentile of the sampled relative errors (no band, no linearisation)."""
-    s = spread(gamma, h, settings, model, pert, target=target, points=points, linear=False)
+    s = spread(
+        gamma, h, settings, model, pert, target=target, points=points, linear=False, device=device
+    )
     return float(np.quantile(s.errors, 0.95))
 
 
@@ -213,6 +221,7 @@ def largest_sigma(
     target: tuple[np.ndarray, np.ndarray] | None = None,
     iterations: int = 30,
     progress: Callable[[], object] | None = None,
+    device: torch.device | None = None,
 ) -> tuple[float, float]:
     """The largest height error sigma_h [units of R] whose p95 error stays within
     ``max_error``, the other sigmas of ``pert`` kept; and the p95 error there.
@@ -221,12 +230,13 @@ def largest_sigma(
     (common random numbers: the p95 is then a smooth, increasing function of sigma_h, not
     a noisy one). Returns (0, p95 at sigma_h = 0) when even perfect heights miss the budget,
     and (inf, p95 at the top) when the top still meets it. ``progress`` is called after
-    each probe (at most ``iterations`` + 3).
+    each probe (at most ``iterations`` + 3). Every probe runs on ``device`` (default the CPU).
     """
+    pert = pert.to(device or torch.device("cpu"))  # moved once, not at every probe
 
     def probe(sigma: float) -> float:
         q = Perturbation(sigma, pert.sigma_gamma, pert.scale_sigma, pert.z)
-        err = p95(gamma, h, settings, model, q, target=target)
+        err = p95(gamma, h, settings, model, q, target=target, device=device)
         if progress is not None:
             progress()
         return err

@@ -21,10 +21,22 @@ from metainterface.surrogate.model import InverseMLP
 MODEL_FORMAT = "metainterface/surrogate-v1"
 
 
+def _on_cpu(obj: Any) -> Any:
+    """``obj`` with every tensor in it (nested dicts, lists, tuples) moved to the CPU."""
+    if isinstance(obj, torch.Tensor):
+        return obj.cpu()  # the tensor itself when it is there already
+    if isinstance(obj, dict):
+        return {k: _on_cpu(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return type(obj)(_on_cpu(v) for v in obj)
+    return obj
+
+
 def save_torch(path: str | os.PathLike[str], obj: Any) -> Path:
-    """torch.save, atomically (write then rename)."""
+    """torch.save, atomically (write then rename); tensors are saved from the CPU, so a file
+    made on a GPU loads anywhere."""
     buf = io.BytesIO()
-    torch.save(obj, buf)
+    torch.save(_on_cpu(obj), buf)
     return write_bytes(path, buf.getvalue())
 
 

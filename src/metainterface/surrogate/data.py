@@ -27,6 +27,24 @@ class Split:
     def __len__(self) -> int:
         return self.features.shape[0]
 
+    def to(self, device: torch.device) -> Split:
+        """The split with its tensors on ``device`` (itself when they are there already)."""
+        if self.features.device == device:
+            return self
+        t = self.targets
+        return Split(
+            self.features.to(device),
+            CurveTargets(
+                t.alpha_hat.to(device),
+                t.stiffness_hat.to(device),
+                t.p_star_max.to(device),
+                t.alpha_max.to(device),
+            ),
+            self.gamma.to(device),
+            self.h.to(device),
+            self.category,
+        )
+
     def rows(self, idx: Tensor) -> tuple[Tensor, CurveTargets, Tensor, Tensor]:
         """The rows ``idx`` (a 1-D index tensor): features, targets, gamma, h."""
 

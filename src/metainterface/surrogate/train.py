@@ -27,6 +27,7 @@ import torch
 from tqdm.auto import tqdm
 
 from metainterface import _checks
+from metainterface._device import resolve_device
 from metainterface._files import strict_json
 from metainterface._files.atomic import output_set, write_text
 from metainterface._files.columns import write_columns
@@ -52,6 +53,10 @@ class TrainConfig:
     epochs, batch_size, lr, weight_decay, patience, seed
         AdamW with a cosine learning rate peaking at ``lr``; early stopping after
         ``patience`` epochs without a better validation loss; ``seed`` fixes every draw.
+        ``batch_size`` and ``lr`` go together: 1024 with 2e-3 by default (the shipped model
+        was trained with 512 and 2e-3). A GPU is busy only with larger batches (8192);
+        fewer steps per epoch then need a larger ``lr`` (docs/concepts/devices.md), so
+        change both or neither.
     curriculum_epochs, lambda_start
         The supervised anchor lambda falls linearly from ``lambda_start`` to 0 over
         ``curriculum_epochs``.
@@ -156,12 +161,13 @@ def evaluate_loss(
     weights: LossWeights = PAPER_WEIGHTS,
     chunk: int = 4096,
 ) -> float:
-    """Mean exact-physics loss of the model on a split (no gradients, eval mode)."""
+    """Mean exact-physics loss of the model on a split (no gradients, eval mode), on the
+    split's device (the model must be there too)."""
     model.eval()
     total = 0.0
     with torch.no_grad():
         for lo in range(0, len(split), chunk):
-            idx = torch.arange(lo, min(lo + chunk, len(split)))
+            idx = torch.arange(lo, min(lo + chunk, len(split)), device=split.features.device)
             feats, targets, _, _ = split.rows(idx)
             gamma, h = model.design(feats, settings)
             total += float(physics_loss(curve(gamma, h, settings), targets, weights)) * len(idx)
@@ -189,14 +195,22 @@ def train(
     resume: bool = False,
     progress: bool = True,
     dataset_info: dict[str, Any] | None = None,
+    device: str | torch.device = "cpu",
 ) -> TrainResult:
-    """Train (or resume) a surrogate in ``out_dir``; returns a summary of the run."""
+    """Train (or resume) a surrogate in ``out_dir``; returns a summary of the run.
+
+    ``device`` ("auto", "cpu", "cuda", "cuda:N"): where the model, both splits and every
+    step live. The model file and checkpoint hold CPU tensors whatever the device, so a
+    run can be resumed, and its model used, on another one."""
     config = config or TrainConfig()
     _check_sizes(train_split, val_split, config.batch_size)
+    dev = resolve_device(device)
+    # the whole dataset on the device once: batches are then gathers there, no copies
+    train_split, val_split = train_split.to(dev), val_split.to(dev)
     out = Path(out_dir)
     ckpt_path = out / "checkpoint.pt"
     torch.manual_seed(config.seed)
-    model = InverseMLP(settings.n_asperities, settings.n_steps, config.max_gap)
+    model = InverseMLP(settings.n_asperities, settings.n_steps, config.max_gap).to(dev)
     model.set_input_scaling(train_split.features)
     # fused: one kernel for all parameters, half the optimiser time of the foreach default
     opt = torch.optim.AdamW(
@@ -221,6 +235,8 @@ def train(
         opt.load_state_dict(state["optimizer"])
         sched.load_state_dict(state["scheduler"])
         torch.set_rng_state(state["rng"])
+        if dev.type == "cuda" and "cuda_rng" in state:  # dropout draws there on CUDA
+            torch.cuda.set_rng_state(state["cuda_rng"], dev)
         start, best, best_epoch, bad = (
             state["epoch"],
             state["best"],
@@ -254,10 +270,14 @@ def train(
         t0 = time.perf_counter()
         kappa, lam = schedules.kappa(epoch), schedules.lam(epoch)
         model.train()
+        # drawn on the CPU whatever the device: the same seed, the same batches everywhere
         order = torch.randperm(
             n, generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch)
-        )
-        run_loss, batches = 0.0, 0
+        ).to(dev)
+        # summed on the device and read once an epoch (a float() per batch would wait for
+        # each step to finish); float64, so the sum equals the per-batch Python sum on CPU
+        epoch_loss = torch.zeros((), dtype=torch.float64, device=dev)
+        batches = 0
         for lo in range(0, n - config.batch_size + 1, config.batch_size):
             feats, targets, g_t, h_t = train_split.rows(order[lo : lo + config.batch_size])
             gamma, h = model.design(feats, settings)
@@ -268,8 +288,9 @@ def train(
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()
-            run_loss += float(loss.detach())
+            epoch_loss += loss.detach()
             batches += 1
+        run_loss = float(epoch_loss)
         lr = opt.param_groups[0]["lr"]
         sched.step()
         val = evaluate_loss(model, val_split, settings, config.weights)
@@ -309,6 +330,7 @@ def train(
                     "optimizer": opt.state_dict(),
                     "scheduler": sched.state_dict(),
                     "rng": torch.get_rng_state(),
+                    **({"cuda_rng": torch.cuda.get_rng_state(dev)} if dev.type == "cuda" else {}),
                     "epoch": epoch + 1,
                     "best": best,
                     "best_epoch": best_epoch,

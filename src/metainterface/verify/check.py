@@ -120,10 +120,11 @@ class Verify:
         return self.correct
 
 
-def as_verify(verify: Any) -> Verify | None:
-    """``design``'s ``verify`` argument as settings, or None for no check."""
+def as_verify(verify: Any, device: Any = "auto") -> Verify | None:
+    """``design``'s ``verify`` argument as settings, or None for no check; True checks on
+    ``device`` (a ``Verify`` keeps its own)."""
     if verify is True:
-        return Verify()
+        return Verify(device=device if isinstance(device, str) else str(device))
     if verify is False or verify is None:
         return None
     if isinstance(verify, Verify):
