@@ -155,6 +155,7 @@ def main() -> None:
     ap.add_argument("--engine", default="torch", help="contact solver (torch)")
     ap.add_argument("--device", default="auto", help="torch engine's device (auto)")
     ap.add_argument("--no-analytic", action="store_true", help="leave out the analytic laws")
+    ap.add_argument("--only", nargs="+", metavar="NAME", help="check only these targets")
     ap.add_argument(
         "--cross", action="store_true", help="measure the first grid's correction on the last grid"
     )
@@ -171,10 +172,16 @@ def main() -> None:
     targets += realisable_targets(args.n_random, seed=HELD_OUT_SEED)
     if not args.no_analytic:
         targets += analytic_laws()
+    if args.only:
+        targets = [t for t in targets if t.name in args.only]
     t0 = time.perf_counter()
     designs = mi.design(targets, verify=False)
     t_design = time.perf_counter() - t0
-    rows = [run_target(r, args.grids, args) for r in tqdm(designs, desc="BEM check + correct")]
+    rows = []
+    for r in tqdm(designs, desc="BEM check + correct"):
+        rows.append(run_target(r, args.grids, args))
+        if args.out:  # the rows so far, so a long run that is stopped still leaves them
+            Path(args.out).with_suffix(".json").write_text(json.dumps(rows, indent=1, default=str))
     text = table(rows, args.grids, args.cross)
     notes = summary(rows, args.grids)
     threads = torch.get_num_threads()
