@@ -9,7 +9,7 @@ shifted by the defect,
 
 has b(x_{i+1}) ~ m(x_{i+1}) - d_i ~ alpha_target: the model's error is corrected with the
 BEM's own answer (output space mapping, Bandler et al., IEEE Trans. Microw. Theory Tech. 42
-(1994) 2536, and Koziel, Bandler & Madsen, IEEE Trans. Microw. Theory Tech. 54 (2006) 2166;
+(1994) 2536, and Koziel, Bandler & Madsen, IEEE Trans. Microw. Theory Tech. 54 (2006) 3721;
 defect correction, Stetter, Numer. Math. 29 (1978) 425). Each iteration re-refines from the
 current design with the refinement's polish, then solves the new design in BEM; it is kept
 only if its BEM error fell, otherwise the step s is halved (1, 1/2, 1/4, ...) from the same
