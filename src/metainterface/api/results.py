@@ -18,12 +18,11 @@ from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.limits import PressureCheck
 from metainterface.physics.models import ForwardModel, get_model
+from metainterface.verify import BemCheck, Correction
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
-
-    from metainterface.verify import BemCheck, Correction
 
 #: Delta samples of a curve when none are asked for.
 CURVE_STEPS = 256

@@ -57,7 +57,7 @@ class Verify:
     loads : int
         K uniform loads over the target's pressure range, in [2, 200].
     correct : bool or None
-        Correct the design in BEM (output space mapping, :mod:`metainterface.verify.correct`);
+        Correct the design in BEM (output space mapping, ``metainterface.verify.correct``);
         None (default): only where the BEM error exceeds the model's own error at the same
         loads by more than 0.5 points (``AUTO_CORRECT_MARGIN``).
     iterations : int
