@@ -172,3 +172,13 @@ def test_cli_engine_option_names_itself(tmp_path, capsys):
     with pytest.raises(SystemExit) as done:  # argparse's own one-line error
         main(args)
     assert done.value.code == 2 and "--verify-engine" in capsys.readouterr().err
+
+
+def test_cli_reports_each_correction_iteration(tmp_path, capsys):
+    args = ["design", "--target", "bilinear", "--out", str(tmp_path), "--verify-grid", "96"]
+    args += ["--verify-loads", "4", "--correct", "--max-bem-error", "10"]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "bilinear corrected in BEM:" in text and "iterations: " in text
+    block = json.loads((tmp_path / "design.json").read_text())["bem_check"]
+    assert len(block["corrections"]) == 3 and block["bem_error"] < block["uncorrected"]["bem_error"]

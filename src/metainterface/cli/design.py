@@ -344,9 +344,12 @@ def _bem_legend(results: list) -> str:
     )
     fixed = [r for r in results if r.bem_before is not None and r.bem is not r.bem_before]
     for r in fixed:
+        steps = ", ".join(
+            f"{100 * c.bem_error:.3g} %{'' if c.accepted else ' (not kept)'}" for c in r.corrections
+        )
         line += (
             f"; {r.target.name} corrected in BEM: {100 * r.bem_before.bem_error:.3g} % -> "
-            f"{100 * r.bem.bem_error:.3g} % in {len(r.corrections)} iterations"
+            f"{100 * r.bem.bem_error:.3g} % (iterations: {steps})"
         )
     return line
 
