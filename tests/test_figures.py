@@ -114,7 +114,7 @@ def friction_result(tmp_path_factory):
         law, shear_strength="0.25MPa", modulus="2MPa", radius="0.5mm", area="4cm2"
     )
     # no cell reaches this law at these E*, tau and area: the figure of a forced design
-    return mi.design(t, refine=False, hedge=0, fallback=0, force=True)
+    return mi.design(t, refine=False, hedge=0, fallback=0, force=True, verify=False)
 
 
 @pytest.fixture(scope="module")
@@ -122,7 +122,7 @@ def csv_result(tmp_path_factory):
     """A CSV target much longer than the design's pressure range needs."""
     p = np.linspace(0.0, 0.002, 5000)
     t = mi.Target(p_star=p, alpha=0.04 * (1 - np.exp(-p / 0.0006)), name="measured")
-    return mi.design(t, refine=False, hedge=0, fallback=0)
+    return mi.design(t, refine=False, hedge=0, fallback=0, verify=False)
 
 
 @pytest.mark.parametrize("width", [SMALL, LARGE])

@@ -10,7 +10,7 @@ Start here::
     import metainterface as mi
     t = mi.Target.builtin("bilinear")        # or mi.Target(p_star=..., alpha=...),
                                              # mi.Target.from_csv, mi.Target.from_friction
-    r = mi.design(t)                         # DesignResult: .design, .error, .plot()
+    r = mi.design(t)                         # DesignResult: .design, .error, .bem_error, .plot()
     c = mi.curve(r.design, model="interacting")   # Curve: numpy p_star, alpha, stiffness
     v = mi.validate(r.design, grid=96, loads=4)   # BEM check (torch; engine="tamaas": [bem])
     mi.export(r.design, "patch.stl", radius="0.5mm", tiles=(2, 2))
@@ -22,6 +22,9 @@ Designing
     follow this friction law at this E*, tau and area?), Reachability, UnreachableError,
     feasible_scale (which area, E* or tau makes a friction law reachable, FeasibleScale),
     design_scale (a friction law designed with its area, E* or tau chosen too)
+Checked in BEM
+    Verify (how design checks, and corrects, each design in BEM), BemCheck (the BEM curve
+    and its error to the target: DesignResult.bem)
 Curves and forward models
     curve, Curve, ForwardModel, Independent, Interacting, MODELS, get_model, register_model
 Checking and making
@@ -98,6 +101,8 @@ _HOMES: dict[str, str] = {
     "TrainConfig": "metainterface.surrogate.train",
     "ValidationResult": "metainterface.validation.validate",
     "FeasibleScale": "metainterface.inverse.scale",
+    "BemCheck": "metainterface.verify.check",
+    "Verify": "metainterface.verify.check",
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
@@ -140,6 +145,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.runtime import tune_allocator
     from metainterface.surrogate.train import TrainConfig
     from metainterface.validation.validate import ValidationResult
+    from metainterface.verify.check import BemCheck, Verify
 
 
 def __getattr__(name: str) -> Any:
@@ -176,6 +182,7 @@ sys.modules[__name__].__class__ = _Face
 
 __all__ = [
     "MODELS",
+    "BemCheck",
     "CellSettings",
     "Curve",
     "Design",
@@ -192,6 +199,7 @@ __all__ = [
     "TrainConfig",
     "UnreachableError",
     "ValidationResult",
+    "Verify",
     "__version__",
     "compare",
     "curve",

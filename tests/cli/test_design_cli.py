@@ -17,7 +17,8 @@ def test_design_cli_writes_outputs(tmp_path, capsys):
         "p_star,alpha\n"
         + "\n".join(f"{p},{a}" for p, a in zip(t.p_star[::8], t.alpha[::8], strict=True))
     )
-    assert main(["design", "--target-csv", str(csv), "--out", str(out), "--refine", "none"]) == 0
+    args = ["design", "--target-csv", str(csv), "--out", str(out), "--refine", "none"]
+    assert main([*args, "--no-verify"]) == 0
     folder = out  # one target: its files directly in --out
     assert {p.name for p in folder.iterdir()} == {"design.json", "curve.csv", "design.png"}
     data = json.loads((folder / "design.json").read_text())
@@ -38,7 +39,7 @@ def test_a_long_target_makes_a_small_design_file(tmp_path, capsys):
     )
     out = tmp_path / "out"
     args = ["design", "--target-csv", str(csv), "--out", str(out), "--refine", "none"]
-    assert main([*args, "--full-target"]) == 0
+    assert main([*args, "--full-target", "--no-verify"]) == 0
     data = json.loads((out / "design.json").read_text())
     assert (out / "design.json").stat().st_size < 80_000
     assert data["target"]["points"] == 20_000 and len(data["target"]["p_star"]) <= 1024
@@ -77,6 +78,7 @@ def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, ca
     out = tmp_path / "out"
     args = [
         "design",
+        "--no-verify",
         "--friction-csv",
         str(csv),
         "--shear-strength",
@@ -107,7 +109,7 @@ def test_design_from_a_friction_law_with_units_and_a_pressure_limit(tmp_path, ca
 
 def test_compare_of_one_target_writes_into_out(tmp_path):
     out = tmp_path / "cmp"
-    quick = ["--refine", "none", "--starts", "2", "--hedge", "0", "--fallback", "0"]
+    quick = ["--refine", "none", "--starts", "2", "--hedge", "0", "--fallback", "0", "--no-verify"]
     assert main(["design", "--target", "linear", "--compare", "--out", str(out), *quick]) == 0
     assert {p.name for p in out.iterdir()} == {"surrogate", "multistart", "hertz", "compare.png"}
     assert (out / "hertz" / "design.json").is_file()

@@ -89,12 +89,19 @@ def test_design_outputs_are_strict_json(tmp_path, capsys):
             "2",
             "--out",
             str(tmp_path / "d"),
+            "--verify-grid",
+            "96",
+            "--verify-loads",
+            "3",
+            "--max-bem-error",
+            "100",
         ],
         capsys,
     )
     assert rc == 0
     record = strict_json(tmp_path / "d" / "design.json")
     assert record["format"] == "metainterface/design-v1"
+    assert record["bem_check"]["grid"] == 96
     assert not [p for p in (tmp_path / "d").iterdir() if p.name.startswith(".")]
 
 

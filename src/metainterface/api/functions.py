@@ -39,6 +39,7 @@ from metainterface.physical.units import (
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.limits import PressureCheck, check_pressure, pressure_penalty
 from metainterface.physics.models import ForwardModel, get_model
+from metainterface.verify.check import Verify, as_verify
 
 #: Upper bounds that keep a request within this machine's memory and a sane run time.
 MAX_STARTS = 10_000
@@ -132,8 +133,9 @@ def design(
     z_step: float | str | None = None,
     device: str = "auto",
     force: bool = False,
+    verify: bool | Verify = True,
 ) -> DesignResult | list[DesignResult]:
-    """Design a unit cell whose alpha(P*) follows each target.
+    """Design a unit cell whose alpha(P*) follows each target, checked in BEM.
 
     Parameters
     ----------
@@ -198,13 +200,20 @@ def design(
         ('1um') with ``radius``; at most Delta_max. ``result.printable`` reports the error
         before the snap, after it and after the re-refine.
     device : str
-        Where the refinement runs: ``"auto"`` (CUDA when torch sees it, else the CPU),
-        ``"cpu"``, ``"cuda"`` or ``"cuda:N"``. Every target's starts go in one batch; the
-        starts are drawn on the CPU, so a seed gives the same starts on every device.
+        Where the refinement (and the BEM check, with ``verify=True``) runs: ``"auto"``
+        (CUDA when torch sees it, else the CPU), ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
+        Every target's starts go in one batch; the starts are drawn on the CPU, so a seed
+        gives the same starts on every device.
     force : bool
         Design a friction-law target that no cell can follow anyway (see
         :func:`~metainterface.reachability`): the closest cell, marked ``result.forced``.
         Without it such a target raises :class:`~metainterface.UnreachableError` first.
+    verify : bool or Verify
+        Check each design in the boundary element method and report its error to the
+        target there (``result.bem_error``, ``result.bem``), correcting it in BEM where the
+        BEM adds to the model's error (default True: ``Verify()``, 10 loads on a 384^2 grid
+        for the paper's cell); a ``Verify`` sets the grid, loads, correction and threshold;
+        False skips the check.
 
     Returns
     -------
@@ -234,6 +243,9 @@ def design(
     if not isinstance(full_target, bool):
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
     fm = get_model(model)
+    checks = as_verify(verify, device)
+    if checks is not None:  # a bad grid or device fails now, not after the design
+        checks.ready(settings or CellSettings())
     limit = _limit(max_pressure, modulus)
     extra_loss = None
     if limit is not None:
@@ -268,6 +280,10 @@ def design(
         results = [_robust_stats(r, perturb, seed, dev) for r in results]
     if step is not None:
         results = [_printable_record(r, radius_m) for r in results]
+    if checks is not None:
+        results = _verify_all(
+            results, checks, extra_loss, refine_settings, step, perturb, limit, modulus
+        )
     if out is not None:
         out = Path(out)
         folders = [out] if single else [out / r.target.name for r in results]
@@ -391,13 +407,47 @@ def _printable_record(r: DesignResult, radius_m: float | None) -> DesignResult:
     return replace(r, printable=q)
 
 
+def _verify_all(
+    results: list[DesignResult],
+    checks: Verify,
+    extra_loss: Any,
+    refine_settings: RefineSettings | None,
+    step: float | None,
+    perturb: Perturbation | None,
+    limit: float | None,
+    modulus: Any,
+) -> list[DesignResult]:
+    """Each result checked (and where asked, corrected) in BEM; a corrected design gets its
+    pressure check again."""
+    from metainterface.api.verified import verified
+
+    out = []
+    for r in results:
+        v = verified(
+            r,
+            checks,
+            extra_loss=extra_loss,
+            refine_settings=refine_settings,
+            z_step=step,
+            robust=perturb is not None,
+        )
+        if v.design is not r.design and r.pressure is not None:
+            v = replace(v, pressure=_pressure(v.design, limit, modulus))
+        out.append(v)
+    return out
+
+
+def _pressure(d: Design, limit: float | None, modulus: Any) -> PressureCheck | None:
+    if limit is None:
+        return None
+    e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
+    return check_pressure(d, limit if e_star is None else limit * e_star, e_star=e_star)
+
+
 def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> DesignResult:
     d = Design(gamma=r.gamma, h=r.h, settings=r.settings)
     notes = (*r.notes, *pipeline.reachability_warnings(r.target, r.settings))
-    pressure = None
-    if limit is not None:
-        e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
-        pressure = check_pressure(d, limit if e_star is None else limit * e_star, e_star=e_star)
+    pressure = _pressure(d, limit, modulus)
     out = DesignResult(
         target=r.target,
         design=d,

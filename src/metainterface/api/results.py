@@ -19,6 +19,7 @@ from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.limits import PressureCheck
 from metainterface.physics.models import ForwardModel, get_model
+from metainterface.verify import BemCheck, Correction
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -288,6 +289,13 @@ class DesignResult:
         only past the target's largest load).
     carrying : int
         The number of load-carrying asperities, N - len(idle).
+    bem : BemCheck or None
+        The design's check in BEM (``verify``): the BEM curve at the check's loads and its
+        error to the target (:attr:`bem_error`); None when not verified.
+    bem_before : BemCheck or None
+        When the design was corrected in BEM: the check of the uncorrected design.
+    corrections : tuple of Correction
+        The correction's iterations (step, BEM error, kept or not), empty if none ran.
     """
 
     target: Target
@@ -305,6 +313,9 @@ class DesignResult:
     printable: dict[str, Any] | None = None
     robust_error_refined: float | None = None
     forced: bool = False
+    bem: BemCheck | None = None
+    bem_before: BemCheck | None = None
+    corrections: tuple[Correction, ...] = ()
 
     @functools.cached_property
     def _reach(self) -> tuple[float, tuple[int, ...]]:
@@ -321,6 +332,16 @@ class DesignResult:
     @property
     def carrying(self) -> int:
         return self.design.n_asperities - len(self.idle)
+
+    @property
+    def bem_error(self) -> float | None:
+        """The BEM curve's relative error to the target (None when not verified)."""
+        return None if self.bem is None else self.bem.bem_error
+
+    @property
+    def bem_ok(self) -> bool | None:
+        """The BEM error is within the threshold asked for (None when not verified)."""
+        return None if self.bem is None else self.bem.ok
 
     @property
     def origin(self) -> str:
@@ -391,7 +412,21 @@ class DesignResult:
             **({"pressure_check": self.pressure.to_dict()} if self.pressure else {}),
             **({"robust": self.robust} if self.robust else {}),
             **({"printable": self.printable} if self.printable else {}),
+            **({"bem_check": self.bem_record()} if self.bem is not None else {}),
         }
+
+    def bem_record(self) -> dict[str, Any]:
+        """design.json's "bem_check" block: the check of the design handed over and, if it
+        was corrected, the uncorrected design's errors and each iteration."""
+        assert self.bem is not None
+        block = self.bem.to_dict()
+        if self.bem_before is not None:
+            block["uncorrected"] = {
+                "bem_error": self.bem_before.bem_error,
+                "model_error": self.bem_before.model_error,
+            }
+            block["corrections"] = [c.to_dict() for c in self.corrections]
+        return block
 
     def save(
         self, folder: str | os.PathLike[str], *, full_target: bool = False, **extra: Any
@@ -419,6 +454,11 @@ class DesignResult:
                 f"{_percent(q['error_after_refine'])}"
             )
         forced = "FORCED (target unreachable), " if self.forced else ""
+        if self.bem is not None:
+            before = self.bem_before
+            fixed = "" if before is None else f", corrected from {_percent(before.bem_error)}"
+            flag = "" if self.bem.ok else f" (above {_percent(self.bem.max_error)})"
+            made += f", BEM error {_percent(self.bem.bem_error)}{flag} on {self.bem.grid}^2{fixed}"
         return (
             f"DesignResult({forced}target={self.target.name!r}, method={self.method!r}, "
             f"model={self.model.label!r}, error={_percent(self.error)}, "

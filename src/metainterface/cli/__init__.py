@@ -41,7 +41,13 @@ ALL_OR_NOTHING = frozenset({"curve", "export", "generate", "evaluate"})
 
 #: Library argument names that a command's options spell differently.
 OPTION_NAMES = {
-    "design": {"model": "--physics", "surrogate": "--model"},
+    "design": {
+        "model": "--physics",
+        "surrogate": "--model",
+        "grid": "--verify-grid",
+        "loads": "--verify-loads",
+        "engine": "--verify-engine",
+    },
     "curve": {"model": "--physics"},
     "validate": {"model": "--physics"},
 }

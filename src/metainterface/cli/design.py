@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from metainterface._names import DEFAULT_MODEL, FIT_NAMES, METHOD_NAMES, MODEL_NAMES
+from metainterface._names import (
+    DEFAULT_ENGINE,
+    DEFAULT_MODEL,
+    ENGINE_NAMES,
+    FIT_NAMES,
+    METHOD_NAMES,
+    MODEL_NAMES,
+)
 from metainterface.cli.common import add_device, positive_int
 
 
@@ -14,7 +21,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="design a unit cell for a target contact law (the main job)",
         description="Zero-shot prediction by the shipped surrogate, then multi-stage L-BFGS "
         "refinement (or a multistart / Hertz-only baseline). Writes design.json, curve.csv "
-        "and design.png into --out (one folder per target when there are several).",
+        "and design.png into --out (one folder per target when there are several). Each "
+        "design is then checked in the boundary element method (BEM) and its BEM error to the "
+        "target reported beside the model's; exit status 3 when a design's BEM error is above "
+        "--max-bem-error (the files are written all the same), 2 on bad input.",
     )
     src = p.add_argument_group("targets (one or more)")
     src.add_argument(
@@ -148,6 +158,53 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="peak contact pressure limit: p/E* (number) or a stress with --modulus",
     )
     add_device(p)
+    check = p.add_argument_group(
+        "BEM check (on by default; docs: concepts/verification)",
+        "each design is solved in BEM at --verify-loads loads over the target's range and "
+        "its error to the target reported; exit status 3 when above --max-bem-error",
+    )
+    check.add_argument(
+        "--no-verify",
+        dest="verify",
+        action="store_false",
+        help="skip the BEM check (and the correction)",
+    )
+    check.add_argument(
+        "--verify-grid",
+        type=positive_int,
+        metavar="M",
+        help="BEM grid points per cell side, a multiple of sqrt(N) (default 128 sqrt(N): 384; "
+        "768 is the paper's resolution)",
+    )
+    check.add_argument(
+        "--verify-loads", type=int, default=10, metavar="K", help="loads of the check (10)"
+    )
+    check.add_argument(
+        "--correct",
+        dest="correct",
+        action="store_true",
+        default=None,
+        help="correct every design in BEM (output space mapping, up to 3 BEM solves); by "
+        "default only where the BEM adds more than 0.5 points to the model's error",
+    )
+    check.add_argument(
+        "--no-correct", dest="correct", action="store_false", help="never correct in BEM"
+    )
+    check.add_argument(
+        "--max-bem-error",
+        type=float,
+        default=2.0,
+        metavar="PERCENT",
+        help="BEM error a design is trusted within, in per cent (default 2): above it the "
+        "summary says so and the exit status is 3",
+    )
+    check.add_argument(
+        "--verify-engine",
+        choices=ENGINE_NAMES,
+        default=DEFAULT_ENGINE,
+        help="contact solver of the check: torch (default; CPU threads or a GPU) or tamaas "
+        "(the [bem] extra, the reference)",
+    )
     p.set_defaults(func=run)
 
 
@@ -285,6 +342,7 @@ def run(args: argparse.Namespace) -> int:
         full_target=args.full_target,
         device=args.device,
         force=args.force,
+        verify=_verify(args),
         **_manufacturing(args),
     )
     try:
@@ -308,7 +366,13 @@ def run(args: argparse.Namespace) -> int:
             page = mi.view(out if len(results) == 1 else out / r.target.name)
             print(f"{page}: interactive view, opens in a browser")
     print(f"written to {args.out}")
-    return 0
+    high = [r for r in results if r.bem is not None and not r.bem_ok]
+    for r in high:
+        print(
+            f"{r.target.name}: BEM error {100 * r.bem.bem_error:.3g} % is above "
+            f"--max-bem-error {100 * r.bem.max_error:g} %: the made surface will miss the target"
+        )
+    return 3 if high else 0
 
 
 def _run(args: argparse.Namespace, targets: list, options: dict) -> list:
@@ -340,6 +404,9 @@ def _table(args: argparse.Namespace, results: list) -> None:
         f"{'target':<{width}}{'method':<12}{'zero-shot':>11}{'error':>11}{'coverage':>10}"
         f"{'carrying':>10}{'seconds':>9}"
     )
+    checked = [r for r in results if r.bem is not None]
+    if checked:
+        head += f"{'BEM':>11}{'BEM s':>8}"
     if args.robust:
         head += f"{'made p50':>11}{'made p95':>11}"
     if args.z_step is not None:
@@ -356,6 +423,8 @@ def _table(args: argparse.Namespace, results: list) -> None:
         if r.printable:
             q = r.printable
             line += f"{100 * q['error_before_snap']:>9.3g} %{100 * q['error_after_snap']:>9.3g} %"
+        if r.bem is not None:
+            line += f"{100 * r.bem.bem_error:>9.3g} %{_bem_seconds(r):>8.1f}"
         if r.forced:
             line += "  FORCED (out of reach)"
         print(line)
@@ -370,6 +439,55 @@ def _table(args: argparse.Namespace, results: list) -> None:
         "error: sqrt(fit^2 + (1 - coverage)^2), fit over the loads the design reaches; "
         "coverage: the share of the target's load range it reaches"
     )
+    if checked:
+        print(_bem_legend(checked))
+
+
+def _verify(args: argparse.Namespace):
+    """The BEM check's settings from the options, or False with --no-verify."""
+    import metainterface as mi
+    from metainterface.verify import Verify
+
+    if not args.verify:
+        return False
+    if not 0 < args.max_bem_error <= 100:
+        raise mi.MetainterfaceError(
+            f"--max-bem-error must be a percentage in (0, 100], got {args.max_bem_error:g}"
+        )
+    return Verify(
+        grid=args.verify_grid,
+        loads=args.verify_loads,
+        correct=args.correct,
+        max_error=args.max_bem_error / 100,
+        engine=args.verify_engine,
+        device=args.device,
+    )
+
+
+def _bem_seconds(r) -> float:
+    """Wall time of a result's BEM solves [s]: the check, and the correction's."""
+    return (r.bem_before or r.bem).seconds + sum(c.seconds for c in r.corrections)
+
+
+def _bem_legend(results: list) -> str:
+    """What the BEM column is, in one line (with the corrections made)."""
+    b = results[0].bem
+    line = (
+        f"BEM: the design solved in BEM ({b.engine}, {b.grid}^2, {b.p_star.size} loads), "
+        "its error to the target"
+    )
+    fixed = [r for r in results if r.bem_before is not None and r.bem is not r.bem_before]
+    for r in fixed:
+        steps = ", ".join(
+            f"{100 * c.bem_error:.3g} %{'' if c.accepted else ' (not kept)'}" for c in r.corrections
+        )
+        line += (
+            f"; {r.target.name} corrected in BEM: {100 * r.bem_before.bem_error:.3g} % -> "
+            f"{100 * r.bem.bem_error:.3g} % (iterations: {steps})"
+        )
+    return line
+
+
 
 
 def _manufacturing(args: argparse.Namespace) -> dict:

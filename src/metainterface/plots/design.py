@@ -100,6 +100,8 @@ def plot_design(result, curve, *, width: float | None = None) -> Figure:
     coverage = getattr(result, "coverage", 1.0)
     if coverage < 0.999:
         what += f", coverage {percent(coverage)}"
+    if getattr(result, "bem", None) is not None:
+        what += f", BEM {percent(result.bem.bem_error)}"
     name = short(t.name, max(16, min(40, int(5 * width))))
     one_line = len(name) + len(what) + 2 <= min(60, 9 * width)
     title = f"{name}: {what}" if one_line else f"{name}\n{what}"
@@ -116,6 +118,16 @@ def plot_design(result, curve, *, width: float | None = None) -> Figure:
     if stops:
         for ax in (ax_a, ax_s):
             ax.axvline(p_stop, color="C3", ls=":", lw=1.2, label="design stops")
+    bem = getattr(result, "bem", None)
+    if bem is not None:  # the design solved in BEM at the check's loads
+        ax_a.plot(
+            bem.p_star,
+            bem.alpha_bem,
+            "o",
+            color="C3",
+            ms=4,
+            label=f"BEM {bem.grid}$^2$: {percent(bem.bem_error)}",
+        )
     ax_a.set(xlabel=r"$P^* = P/E^*$", ylabel=r"$\alpha = A/A_{nom}$", title="contact area")
     ax_a.set_xlim(0, p_top)
     ax_a.set_ylim(bottom=0)

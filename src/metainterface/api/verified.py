@@ -1,0 +1,64 @@
+"""``design``'s last step: each result checked in BEM and, where it pays, corrected there."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+
+import torch
+from torch import Tensor
+
+from metainterface.api.results import DesignResult
+from metainterface.inverse.params import DTYPE, FixedHeights, Parameterisation
+from metainterface.inverse.pipeline import METHODS
+from metainterface.inverse.refine import RefineSettings
+from metainterface.physics.cell import CellSettings
+from metainterface.verify import Verify, bem_check, correct
+
+
+def verified(
+    r: DesignResult,
+    settings: Verify,
+    *,
+    extra_loss: Callable[[Tensor, Tensor, CellSettings], Tensor] | None = None,
+    refine_settings: RefineSettings | None = None,
+    z_step: float | None = None,
+    robust: bool = False,
+) -> DesignResult:
+    """``r`` with its BEM check (``bem``) and, if ``settings`` asks for it, corrected: then
+    ``design`` and ``error`` are the corrected design's, ``bem_before`` the first check and
+    ``corrections`` every iteration."""
+    check = bem_check(r.design, r.target, settings, r.model)
+    if not settings.wants_correction(check):
+        return replace(r, bem=check)
+    if robust:  # the correction re-refines the nominal design: it would undo the robustness
+        note = "robust design: not corrected in BEM (the correction refines the nominal cell)"
+        return replace(r, bem=check, notes=(*r.notes, note))
+    out = correct(
+        r.design,
+        r.target,
+        check,
+        settings,
+        r.model,
+        param=_parameterisation(r, z_step),
+        extra_loss=extra_loss,
+        refine_settings=refine_settings,
+    )
+    if out.check is check:  # nothing kept: the design stays as it was
+        return replace(r, bem=check, bem_before=check, corrections=out.corrections)
+    return replace(
+        r,
+        design=out.design,
+        error=out.model_error,
+        bem=out.check,
+        bem_before=check,
+        corrections=out.corrections,
+    )
+
+
+def _parameterisation(r: DesignResult, z_step: float | None) -> Parameterisation:
+    """What the design was refined in: gamma = 2 for the Hertz baseline, the heights fixed
+    on a printer's layers."""
+    if z_step is not None:
+        return FixedHeights(h=torch.as_tensor(r.design.h, dtype=DTYPE)[None])
+    return METHODS[r.method]

@@ -1,0 +1,294 @@
+"""The BEM check of a design against its target: what the made surface would show.
+
+A design is refined on a forward model (Sneddon's closed forms); the check solves the same
+cell in the boundary element method at K loads over the target's pressure range and
+measures the BEM curve against the target with the design's own measure,
+
+    bem_error = ||alpha_bem - alpha_target||_2 / ||alpha_target||_2
+
+over the loads inside the target's range (the target interpolated there). The model's error
+at the same loads (``model_error``) stands beside it, so the two read on one scale.
+
+Every BEM solve of this package's design loop goes through :func:`solve_bem`, the one place
+that names the contact solver.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from metainterface import _checks
+from metainterface._names import DEFAULT_ENGINE, ENGINE_NAMES
+from metainterface.errors import MetainterfaceError
+from metainterface.inverse.targets import Target
+from metainterface.physics.cell import CellSettings, Design
+from metainterface.physics.models import ForwardModel, get_model
+
+#: Grid points per lattice cell side of the default check grid: M = 128 n (384 for N = 9).
+#: Coarser grids read the area high by themselves (the bilinear design at 192^2: about +1.2 %
+#: at every load against 384^2 and 768^2, docs/concepts/verification.md), which is the size
+#: of the errors the check is for, and a correction would chase it.
+GRID_PER_ASPERITY = 128
+#: Default number of loads of the check.
+DEFAULT_LOADS = 10
+#: Most correction iterations (each is one BEM load path).
+MAX_ITERATIONS = 20
+#: Auto correction (``correct=None``) runs when the BEM adds more than this to the model's
+#: own error at the check's loads (0.5 points): there the model's defect, which the
+#: correction removes, is what the user would feel. A design the BEM agrees with, or a
+#: target no design reaches (its error is the model's), is handed over as it is. Below it
+#: the default grid's own error (about 0.2-0.3 % at 384^2) is as large as the defect.
+AUTO_CORRECT_MARGIN = 5e-3
+
+
+@dataclass(frozen=True)
+class Verify:
+    """How a design is checked (and corrected) in BEM.
+
+    Attributes
+    ----------
+    grid : int or None
+        M points per cell side, a multiple of sqrt(N) (default ``128 sqrt(N)``, 384 for the
+        paper's cell; the paper's resolution is 768).
+    loads : int
+        K uniform loads over the target's pressure range, in [2, 200].
+    correct : bool or None
+        Correct the design in BEM (output space mapping, ``metainterface.verify.correct``);
+        None (default): only where the BEM error exceeds the model's own error at the same
+        loads by more than 0.5 points (``AUTO_CORRECT_MARGIN``).
+    iterations : int
+        Most BEM solves the correction may spend, in [1, 20].
+    max_error : float
+        The BEM error a design is trusted within (0.02 = 2 %), in (0, 1]; above it the result
+        says so (``DesignResult.bem_ok``) and the command line exits with status 3.
+    engine : str
+        The contact solver: ``"torch"`` (default) or ``"tamaas"``.
+    device : str
+        Where the torch engine runs: ``"auto"``, ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
+    """
+
+    grid: int | None = None
+    loads: int = DEFAULT_LOADS
+    correct: bool | None = None
+    iterations: int = 3
+    max_error: float = 0.02
+    engine: str = DEFAULT_ENGINE
+    device: str = "auto"
+
+    def __post_init__(self) -> None:
+        if self.grid is not None:
+            _checks.whole("grid", self.grid, low=3, high=8192)
+        _checks.whole("loads", self.loads, low=2, high=200)
+        if self.correct is not None and not isinstance(self.correct, bool):
+            raise MetainterfaceError(
+                f"correct must be True, False or None (auto), got {self.correct!r}",
+                argument="correct",
+            )
+        _checks.whole("iterations", self.iterations, low=1, high=MAX_ITERATIONS)
+        _checks.number("max_error", self.max_error, low=0.0, low_open=True, high=1.0)
+        _checks.choice("engine", self.engine, ENGINE_NAMES)
+        if not isinstance(self.device, str):
+            raise MetainterfaceError(
+                f"device must be 'auto', 'cpu', 'cuda' or 'cuda:N', got {self.device!r}",
+                argument="device",
+            )
+
+    def ready(self, cell: CellSettings) -> None:
+        """Check what only the run can tell, before any work: the grid against the cell, the
+        engine installed (Tamaas) and the device seen by torch. One-line errors."""
+        from metainterface.validation.engines import check_engine
+
+        self.grid_for(cell)
+        check_engine(self.engine, self.device)
+
+    def grid_for(self, cell: CellSettings) -> int:
+        """The check's grid for this cell (checked against it)."""
+        from metainterface.validation import check_grid
+
+        if self.grid is None:
+            return GRID_PER_ASPERITY * cell.n_side
+        return check_grid(self.grid, cell)
+
+    def wants_correction(self, check: BemCheck) -> bool:
+        """Whether a design with this check is corrected."""
+        if self.correct is None:
+            return check.bem_error > check.model_error + AUTO_CORRECT_MARGIN
+        return self.correct
+
+
+def as_verify(verify: Any, device: Any = "auto") -> Verify | None:
+    """``design``'s ``verify`` argument as settings, or None for no check; True checks on
+    ``device`` (a ``Verify`` keeps its own)."""
+    if verify is True:
+        return Verify(device=device if isinstance(device, str) else str(device))
+    if verify is False or verify is None:
+        return None
+    if isinstance(verify, Verify):
+        return verify
+    raise MetainterfaceError(
+        f"verify must be True, False or a Verify, got {verify!r}", argument="verify"
+    )
+
+
+@dataclass(frozen=True, repr=False)
+class BemCheck:
+    """A design's contact-area curve in BEM against its target.
+
+    Attributes
+    ----------
+    p_star : ndarray, shape (K,)
+        The loads P* = P / E*, ascending, within the target's range and the design's reach.
+    alpha_bem, alpha_model, alpha_target : ndarray, shape (K,)
+        Contact-area fraction in BEM, from the forward model, and the target's (interpolated)
+        at those loads.
+    bem_error, model_error : float
+        Relative curve error to the target of the BEM and of the model at these loads.
+    grid : int
+        M, grid points per cell side.
+    engine, device : str
+        The contact solver and where it ran.
+    seconds : float
+        Wall time of the BEM solve [s].
+    max_error : float
+        The threshold the design is trusted within.
+    """
+
+    p_star: np.ndarray
+    alpha_bem: np.ndarray
+    alpha_model: np.ndarray
+    alpha_target: np.ndarray
+    bem_error: float
+    model_error: float
+    grid: int
+    engine: str
+    device: str
+    seconds: float
+    max_error: float = 0.02
+    notes: tuple[str, ...] = field(default=())
+
+    @property
+    def ok(self) -> bool:
+        """The BEM error is within ``max_error``."""
+        return self.bem_error <= self.max_error
+
+    @property
+    def rel_err(self) -> np.ndarray:
+        """(K,) alpha_bem / alpha_model - 1: the model's own error at each load."""
+        return self.alpha_bem / self.alpha_model - 1.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the scalars and the per-load values."""
+        return {
+            "bem_error": self.bem_error,
+            "model_error": self.model_error,
+            "max_error": self.max_error,
+            "ok": self.ok,
+            "grid": self.grid,
+            "loads": int(self.p_star.size),
+            "engine": self.engine,
+            "device": self.device,
+            "seconds": self.seconds,
+            "p_star": self.p_star.tolist(),
+            "alpha_bem": self.alpha_bem.tolist(),
+            "alpha_model": self.alpha_model.tolist(),
+            "alpha_target": self.alpha_target.tolist(),
+            **({"notes": list(self.notes)} if self.notes else {}),
+        }
+
+    def __repr__(self) -> str:
+        return (
+            f"BemCheck(BEM error {100 * self.bem_error:.3g} % (model {100 * self.model_error:.3g}"
+            f" %) at {self.p_star.size} loads on {self.grid}x{self.grid}, {self.engine}, "
+            f"{self.seconds:.2g} s{'' if self.ok else ', above ' + f'{100 * self.max_error:g} %'})"
+        )
+
+
+def check_loads(design: Design, target: Target, model: ForwardModel, k: int) -> np.ndarray:
+    """(K,) uniform loads over the target's range, up to the largest the design reaches."""
+    top = min(target.p_star_max, model.model_curve(design).p_star_max)
+    return top * np.arange(1, k + 1) / k
+
+
+def curve_error(alpha: np.ndarray, alpha_target: np.ndarray) -> float:
+    """||alpha - alpha_target||_2 / ||alpha_target||_2 (0 for a zero target)."""
+    norm = float(np.linalg.norm(alpha_target))
+    return float(np.linalg.norm(alpha - alpha_target)) / norm if norm > 0 else 0.0
+
+
+@dataclass(frozen=True)
+class Solved:
+    """One BEM load path of the check: alpha in BEM and from the model (K,), where and how
+    it was solved, and its wall time [s]."""
+
+    alpha_bem: np.ndarray
+    alpha_model: np.ndarray
+    grid: int
+    engine: str
+    device: str
+    seconds: float
+
+
+def solve_bem(design: Design, loads: np.ndarray, settings: Verify, model: ForwardModel) -> Solved:
+    """The one call of the contact solver in the design loop: ``design`` at ``loads`` (K,).
+
+    Raises MetainterfaceError if a solve does not converge.
+    """
+    from metainterface._device import resolve_device
+    from metainterface.validation import plan_validation
+
+    grid = settings.grid_for(design.settings)
+    plan = plan_validation(
+        design, grid=grid, loads=loads, model=model, engine=settings.engine, device=settings.device
+    )
+    device = str(resolve_device(settings.device)) if settings.engine == "torch" else "cpu"
+    t0 = time.perf_counter()
+    result = plan.solve(1)
+    return Solved(
+        alpha_bem=np.asarray(result.alpha_bem, dtype=np.float64),
+        alpha_model=np.asarray(result.alpha_model, dtype=np.float64),
+        grid=grid,
+        engine=plan.engine,
+        device=device,
+        seconds=time.perf_counter() - t0,
+    )
+
+
+def bem_check(
+    design: Design,
+    target: Target,
+    settings: Verify | None = None,
+    model: str | ForwardModel | None = None,
+) -> BemCheck:
+    """Solve ``design`` in BEM at ``settings.loads`` loads and measure it against ``target``.
+
+    model: the forward model the design was made with (its error is reported beside).
+    """
+    settings = settings or Verify()
+    fm = get_model(model)
+    loads = check_loads(design, target, fm, settings.loads)
+    solved = solve_bem(design, loads, settings, fm)
+    alpha_t = np.interp(loads, target.p_star, target.alpha)
+    notes = ()
+    if loads[-1] < target.p_star_max * (1 - 1e-3):  # a design short by a hair is not
+        notes = (
+            f"the design reaches P* = {loads[-1]:.4g} at Delta_max, short of the target's "
+            f"{target.p_star_max:.4g}: the check stops there",
+        )
+    return BemCheck(
+        p_star=loads,
+        alpha_bem=solved.alpha_bem,
+        alpha_model=solved.alpha_model,
+        alpha_target=alpha_t,
+        bem_error=curve_error(solved.alpha_bem, alpha_t),
+        model_error=curve_error(solved.alpha_model, alpha_t),
+        grid=solved.grid,
+        engine=solved.engine,
+        device=solved.device,
+        seconds=solved.seconds,
+        max_error=settings.max_error,
+        notes=notes,
+    )

@@ -1,0 +1,184 @@
+"""Designs checked and corrected in BEM: mi.design(verify=...), the CLI's exit status 3, the
+design.json block and the figure. Small grids (96^2, 4 loads) keep each solve well under a
+second; what the check measures at the paper's resolution is benchmarks/bench_verified.py's."""
+
+import json
+
+import numpy as np
+import pytest
+
+import metainterface as mi
+from metainterface.cli import main
+from metainterface.verify import BemCheck, Verify, bem_check
+from metainterface.verify.check import curve_error
+from metainterface.verify.correct import shifted_target
+
+# at 96^2 the BEM reads the bilinear design ~5 % high by itself (the grid), hence max_error
+QUICK = Verify(grid=96, loads=4, correct=False, max_error=0.1)
+
+
+@pytest.fixture(scope="module")
+def unchecked():
+    return mi.design("bilinear", verify=False)
+
+
+@pytest.fixture(scope="module")
+def checked():
+    return mi.design("bilinear", verify=QUICK)
+
+
+@pytest.fixture(scope="module")
+def corrected():
+    return mi.design("bilinear", verify=Verify(grid=96, loads=4, correct=True, iterations=2))
+
+
+def test_the_check_reports_the_bem_error_to_the_target(checked, unchecked):
+    b = checked.bem
+    assert isinstance(b, BemCheck) and b.grid == 96 and b.p_star.size == 4
+    # uniform loads over the target's range, the target interpolated there
+    t = checked.target
+    np.testing.assert_allclose(b.p_star, t.p_star_max * np.arange(1, 5) / 4, rtol=1e-5)
+    assert not b.notes  # it reaches the end of the target (to 2e-6)
+    np.testing.assert_allclose(b.alpha_target, np.interp(b.p_star, t.p_star, t.alpha))
+    assert checked.bem_error == pytest.approx(curve_error(b.alpha_bem, b.alpha_target))
+    # the design meets this target in the model; the BEM reads the same cell within a few %
+    assert b.model_error < 1e-3 and 0 < b.bem_error < 0.1
+    np.testing.assert_allclose(b.alpha_bem, b.alpha_model, rtol=0.1)
+    assert checked.bem_ok is True and checked.bem_before is None and not checked.corrections
+    # not corrected: the design is the unchecked one, and verify=False adds nothing
+    np.testing.assert_array_equal(checked.design.gamma, unchecked.design.gamma)
+    assert unchecked.bem is None and unchecked.bem_error is None and unchecked.bem_ok is None
+    assert "BEM error" in repr(checked) and "BEM" not in repr(unchecked)
+
+
+def test_the_correction_lowers_the_bem_error(corrected):
+    before, after = corrected.bem_before, corrected.bem
+    assert before is not None and after.bem_error < before.bem_error
+    assert 1 <= len(corrected.corrections) <= 2
+    kept = [c.bem_error for c in corrected.corrections if c.accepted]
+    assert kept and kept[-1] == pytest.approx(after.bem_error)
+    assert all(b < a for a, b in zip([before.bem_error, *kept], kept, strict=False))
+    # the result is the corrected design: its BEM check and model error are its own
+    again = bem_check(corrected.design, corrected.target, Verify(grid=96, loads=4))
+    assert again.bem_error == pytest.approx(after.bem_error, rel=1e-6)
+    assert corrected.error > 1e-3  # it now misses the target in the model, on purpose
+
+
+def test_the_shifted_target_adds_the_defect():
+    t = mi.Target(p_star=[0.0, 1.0, 2.0, 3.0], alpha=[0.0, 0.1, 0.2, 0.3])
+    check = BemCheck(
+        p_star=np.array([1.0, 2.0]),
+        alpha_bem=np.array([0.11, 0.22]),
+        alpha_model=np.array([0.10, 0.20]),
+        alpha_target=np.array([0.1, 0.2]),
+        bem_error=0.1,
+        model_error=0.0,
+        grid=96,
+        engine="tamaas",
+        device="cpu",
+        seconds=0.0,
+    )
+    p, a = shifted_target(t, check, 0.5)
+    # defect model - BEM: 0 at P* = 0, -0.01 and -0.02 at the loads, held beyond
+    np.testing.assert_allclose(a, [0.0, 0.095, 0.19, 0.29])
+    np.testing.assert_array_equal(p, t.p_star)
+
+
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"loads": 1}, "loads"),
+        ({"grid": 2}, "grid"),
+        ({"iterations": 0}, "iterations"),
+        ({"max_error": 0.0}, "max_error"),
+        ({"max_error": 2.0}, "max_error"),
+        ({"engine": "fem"}, "engine"),
+        ({"correct": "yes"}, "correct"),
+        ({"device": 3}, "device"),
+    ],
+)
+def test_bad_settings_give_one_line_naming_the_field(kwargs, name):
+    with pytest.raises(mi.MetainterfaceError) as err:
+        Verify(**kwargs)
+    assert str(err.value).startswith(name) and "\n" not in str(err.value)
+
+
+def test_bad_verify_arguments_fail_before_the_design():
+    with pytest.raises(mi.MetainterfaceError, match="verify must be True, False or a Verify"):
+        mi.design("bilinear", verify="yes")
+    with pytest.raises(mi.MetainterfaceError, match="grid must be a multiple of the lattice"):
+        mi.design("bilinear", verify=Verify(grid=97), method="hertz", starts=1, refine=False)
+
+
+def test_design_json_and_figure_carry_the_check(checked, tmp_path):
+    checked.save(tmp_path)
+    block = json.loads((tmp_path / "design.json").read_text())["bem_check"]
+    assert block["bem_error"] == pytest.approx(checked.bem_error)
+    assert block["grid"] == 96 and block["loads"] == 4 and block["ok"] is True
+    assert len(block["alpha_bem"]) == 4 and "uncorrected" not in block
+    fig = checked.figure()
+    labels = [line.get_label() for line in fig.axes[0].get_lines()]
+    assert any(label.startswith("BEM 96") for label in labels)
+    assert "BEM" in fig._suptitle.get_text()
+
+
+def test_a_corrected_design_records_its_iterations(corrected, tmp_path):
+    corrected.save(tmp_path)
+    block = json.loads((tmp_path / "design.json").read_text())["bem_check"]
+    assert block["uncorrected"]["bem_error"] == pytest.approx(corrected.bem_before.bem_error)
+    assert [c["iteration"] for c in block["corrections"]] == list(
+        range(1, len(corrected.corrections) + 1)
+    )
+
+
+def test_cli_exits_3_above_max_bem_error(tmp_path, capsys):
+    out = tmp_path / "d"
+    args = ["design", "--target", "bilinear", "--out", str(out), "--verify-grid", "96"]
+    args += ["--verify-loads", "4", "--no-correct", "--max-bem-error", "0.001"]
+    assert main(args) == 3
+    text = capsys.readouterr().out
+    assert "BEM" in text.splitlines()[0]
+    assert "is above --max-bem-error 0.001 %" in text
+    assert json.loads((out / "design.json").read_text())["bem_check"]["ok"] is False
+
+
+def test_cli_no_verify_and_bad_options(tmp_path, capsys):
+    assert main(["design", "--target", "bilinear", "--out", str(tmp_path), "--no-verify"]) == 0
+    assert "BEM" not in capsys.readouterr().out
+    assert "bem_check" not in json.loads((tmp_path / "design.json").read_text())
+    bad = ["design", "--target", "bilinear", "--out", str(tmp_path / "x"), "--verify-grid", "97"]
+    assert main(bad) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--verify-grid must be a multiple" in err
+    assert main([*bad[:-2], "--max-bem-error", "150"]) == 2
+    assert "--max-bem-error must be a percentage" in capsys.readouterr().err
+
+
+def test_the_engine_and_device_reach_the_solver_and_fail_early(unchecked):
+    s = Verify(grid=96, loads=3, engine="tamaas")
+    tam = bem_check(unchecked.design, unchecked.target, s, unchecked.model)
+    ours = bem_check(unchecked.design, unchecked.target, Verify(grid=96, loads=3, device="cpu"))
+    assert (tam.engine, tam.device) == ("tamaas", "cpu") and (ours.engine, ours.device) == (
+        "torch",
+        "cpu",
+    )
+    np.testing.assert_allclose(ours.alpha_bem, tam.alpha_bem, rtol=1e-6)
+    with pytest.raises(mi.MetainterfaceError, match="device"):
+        mi.design("bilinear", verify=Verify(device="tpu"), method="hertz", refine=False)
+
+
+def test_cli_engine_option_names_itself(tmp_path, capsys):
+    args = ["design", "--target", "bilinear", "--out", str(tmp_path), "--verify-engine", "fem"]
+    with pytest.raises(SystemExit) as done:  # argparse's own one-line error
+        main(args)
+    assert done.value.code == 2 and "--verify-engine" in capsys.readouterr().err
+
+
+def test_cli_reports_each_correction_iteration(tmp_path, capsys):
+    args = ["design", "--target", "bilinear", "--out", str(tmp_path), "--verify-grid", "96"]
+    args += ["--verify-loads", "4", "--correct", "--max-bem-error", "10"]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "bilinear corrected in BEM:" in text and "iterations: " in text
+    block = json.loads((tmp_path / "design.json").read_text())["bem_check"]
+    assert len(block["corrections"]) == 3 and block["bem_error"] < block["uncorrected"]["bem_error"]
