@@ -282,6 +282,7 @@ def design_scale(
             settings=settings,
             refine_settings=QUICK,
             fallback=0,
+            verify=False,  # candidates are ranked on the model; the chosen one is checked
             **quick_opts,
         )
         return np.array([r.error + uncovered(r) for r in made])
