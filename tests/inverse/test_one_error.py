@@ -56,7 +56,7 @@ def stopped(tmp_path_factory):
         name="longer",
     )
     folder = tmp_path_factory.mktemp("stopped")
-    return mi.design(longer, hedge=0, fallback=0, out=folder), folder
+    return mi.design(longer, hedge=0, fallback=0, out=folder, verify=False), folder
 
 
 def test_design_reports_coverage_and_carrying(stopped):
