@@ -180,7 +180,7 @@ def test_many_targets_pass_the_memory_check(monkeypatch):
     """The check counts the rows refined together: the surrogate's 1 + hedge per target,
     or its fallback's starts afterwards, not their sum with ``starts``."""
     from metainterface import _checks
-    from metainterface.api.functions import _affordable_rows
+    from metainterface.designer.run import _affordable_rows
 
     monkeypatch.setattr(_checks, "memory_total", lambda: 16 * 2**30)
     cpu = torch.device("cpu")

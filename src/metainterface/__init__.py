@@ -63,31 +63,31 @@ except PackageNotFoundError:  # running from a source tree that was not installe
 #: command line's ``--help`` answers without torch); a name's module is imported on first use
 #: (PEP 562), and ``dir(mi)``, ``help(mi)`` and the API reference still list every name.
 _HOMES: dict[str, str] = {
-    "Curve": "metainterface.api",
-    "DesignResult": "metainterface.api",
-    "PrinterSizing": "metainterface.api",
-    "ToleranceResult": "metainterface.api",
-    "compare": "metainterface.api",
-    "curve": "metainterface.api",
-    "design": "metainterface.api",
-    "evaluate_surrogate": "metainterface.api",
-    "export": "metainterface.api",
-    "generate_dataset": "metainterface.api",
-    "min_radius": "metainterface.api",
-    "physical": "metainterface.api",
-    "pressure_check": "metainterface.api",
-    "tolerance": "metainterface.api",
-    "train_surrogate": "metainterface.api",
-    "validate": "metainterface.api",
-    "validate_many": "metainterface.api",
-    "view": "metainterface.api",
-    "write_result": "metainterface.api",
-    "design_scale": "metainterface.api.scale",
-    "feasible_scale": "metainterface.api.scale",
+    "Curve": "metainterface.designer.results",
+    "DesignResult": "metainterface.designer.results",
+    "PrinterSizing": "metainterface.manufacture.sizing",
+    "ToleranceResult": "metainterface.manufacture.tolerance",
+    "compare": "metainterface.designer.run",
+    "curve": "metainterface.designer.given",
+    "design": "metainterface.designer.run",
+    "evaluate_surrogate": "metainterface.surrogate.build",
+    "export": "metainterface.designer.given",
+    "generate_dataset": "metainterface.surrogate.build",
+    "min_radius": "metainterface.manufacture.sizing",
+    "physical": "metainterface.designer.given",
+    "pressure_check": "metainterface.designer.given",
+    "tolerance": "metainterface.manufacture.tolerance",
+    "train_surrogate": "metainterface.surrogate.build",
+    "validate": "metainterface.sweep.validate",
+    "validate_many": "metainterface.sweep.validate",
+    "view": "metainterface.designer.view",
+    "write_result": "metainterface.sweep.validate",
+    "design_scale": "metainterface.designer.scale",
+    "feasible_scale": "metainterface.designer.scale",
     "MetainterfaceError": "metainterface.errors",
     "UnreachableError": "metainterface.errors",
     "Reachability": "metainterface.physical.reach",
-    "reachability": "metainterface.api.reach",
+    "reachability": "metainterface.inverse.reach",
     "Target": "metainterface.inverse.targets",
     "CellSettings": "metainterface.physics.cell",
     "Design": "metainterface.physics.cell",
@@ -106,32 +106,17 @@ _HOMES: dict[str, str] = {
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
-    from metainterface.api import (
-        Curve,
-        DesignResult,
-        PrinterSizing,
-        ToleranceResult,
-        compare,
-        curve,
-        design,
-        evaluate_surrogate,
-        export,
-        generate_dataset,
-        min_radius,
-        physical,
-        pressure_check,
-        tolerance,
-        train_surrogate,
-        validate,
-        validate_many,
-        view,
-        write_result,
-    )
-    from metainterface.api.reach import reachability
-    from metainterface.api.scale import design_scale, feasible_scale
+    from metainterface.designer.given import curve, export, physical, pressure_check
+    from metainterface.designer.results import Curve, DesignResult
+    from metainterface.designer.run import compare, design
+    from metainterface.designer.scale import design_scale, feasible_scale
+    from metainterface.designer.view import view
     from metainterface.errors import MetainterfaceError, UnreachableError
+    from metainterface.inverse.reach import reachability
     from metainterface.inverse.scale import FeasibleScale
     from metainterface.inverse.targets import Target
+    from metainterface.manufacture.sizing import PrinterSizing, min_radius
+    from metainterface.manufacture.tolerance import ToleranceResult, tolerance
     from metainterface.physical.reach import Reachability
     from metainterface.physics.cell import CellSettings, Design
     from metainterface.physics.models import (
@@ -143,7 +128,9 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         register_model,
     )
     from metainterface.runtime import tune_allocator
+    from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
     from metainterface.surrogate.train import TrainConfig
+    from metainterface.sweep.validate import validate, validate_many, write_result
     from metainterface.validation.validate import ValidationResult
     from metainterface.verify.check import BemCheck, Verify
 

@@ -43,7 +43,6 @@ from metainterface._files import (
     write_text,
 )
 from metainterface._names import DEFAULT_ENGINE
-from metainterface.api.cluster import check_scheduler, dask_executor
 from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, open_fields, require_xarray, write_fields
 from metainterface.physics.cell import Design
@@ -55,6 +54,7 @@ from metainterface.validation.bem import (
     LoadPath,
     available_cpus,
 )
+from metainterface.validation.cluster import check_scheduler, dask_executor
 from metainterface.validation.engine import RETRIES, solve_task, stream
 from metainterface.validation.engines import check_engine, get_engine
 from metainterface.validation.validate import (

@@ -10,7 +10,7 @@ from metainterface._files import write_columns
 from metainterface.plots import plot_design, save_figure
 
 if TYPE_CHECKING:
-    from metainterface.api.results import DesignResult
+    from metainterface.designer.results import DesignResult
 
 
 def write_design_outputs(

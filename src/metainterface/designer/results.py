@@ -434,7 +434,7 @@ class DesignResult:
         """Write design.json, curve.csv and design.png into ``folder`` (and target.csv, the
         whole target, with ``full_target``); ``extra`` keys go into design.json. Returns the
         path of design.json."""
-        from metainterface.api.outputs import write_design_outputs
+        from metainterface.designer.outputs import write_design_outputs
 
         return write_design_outputs(Path(folder), self, full_target=full_target, **extra)
 

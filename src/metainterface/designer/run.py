@@ -1,5 +1,6 @@
-"""The public functions: design, compare, curve, export, physical. numpy and lists in,
-numpy out; every argument checked with a one-line MetainterfaceError."""
+"""Designing: :func:`design` (a target to a checked design) and :func:`compare` (all three
+methods). numpy and lists in, numpy out; every argument checked with a one-line
+MetainterfaceError."""
 
 from __future__ import annotations
 
@@ -9,32 +10,24 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from metainterface import _checks
 from metainterface._device import resolve_device
-from metainterface._files import check_output_file, check_output_folder, output_set
-from metainterface.api.reach import refuse_unreachable
-from metainterface.api.results import (
-    CURVE_STEPS,
-    Curve,
+from metainterface._files import check_output_folder, output_set
+from metainterface.designer.given import _limit, _physical_options
+from metainterface.designer.results import (
     DesignResult,
-    design_curve,
-    idle_notes,
     reach_note,
 )
+from metainterface.designer.robust import _manufacturing, _printable_record, _robust_stats
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline
 from metainterface.inverse.perturb import Perturbation
+from metainterface.inverse.reach import refuse_unreachable
 from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
 from metainterface.physical.dimensions import physical_block
 from metainterface.physical.units import (
-    parse_area,
-    parse_force,
-    parse_length,
     parse_pressure,
-    parse_pressure_limit,
 )
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.limits import PressureCheck, check_pressure, pressure_penalty
@@ -43,27 +36,7 @@ from metainterface.verify.check import Verify, as_verify
 
 #: Upper bounds that keep a request within this machine's memory and a sane run time.
 MAX_STARTS = 10_000
-MAX_STEPS = 1_000_000
 MAX_SEED = _checks.MAX_SEED
-#: Physical inputs in SI, with their units for messages: beyond these a number is a typo.
-PHYSICAL_RANGES = {
-    "radius": (1e-9, 10.0, "m"),
-    "modulus": (1e-3, 1e13, "Pa"),
-    "total_force": (1e-12, 1e12, "N"),
-    "area": (1e-18, 1e6, "m^2"),
-}
-#: Softplus steepness kappa_s [1/R]: below this the relaxed bracket is no longer a contact.
-SMOOTH_RANGE = (1.0, 1e15)
-
-
-def _physical(name: str, value: float) -> float:
-    low, high, unit = PHYSICAL_RANGES[name]
-    if not low <= value <= high:
-        raise MetainterfaceError(
-            f"{name} must be between {low:g} and {high:g} {unit}, got {value:g} {unit}",
-            argument=name,
-        )
-    return value
 
 
 #: Memory of one start per asperity during refinement (about twice what the multistart
@@ -93,15 +66,6 @@ def _targets(targets: Target | str | Sequence[Target | str]) -> tuple[list[Targe
     if len(set(names)) != len(names):
         raise MetainterfaceError(f"target names must be distinct, got {', '.join(names)}")
     return out, single
-
-
-def _limit(max_pressure: float | str | None, modulus: str | float | None) -> float | None:
-    if max_pressure is None:
-        return None
-    e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
-    return parse_pressure_limit(
-        max_pressure, e_star=e_star, option="max_pressure", modulus_option="modulus"
-    )
 
 
 def design(
@@ -317,96 +281,6 @@ def _affordable_rows(
         )
 
 
-#: Made cells drawn to report a robust design's error distribution (independent of the
-#: K copies it was refined against).
-ROBUST_REPORT_SAMPLES = 1024
-MAX_ROBUST_SAMPLES = 1024
-
-
-def _manufacturing(
-    robust: Any,
-    sigma_h: Any,
-    sigma_gamma: Any,
-    scale_sigma: Any,
-    robust_samples: Any,
-    z_step: Any,
-    radius: Any,
-    settings: CellSettings | None,
-    seed: int,
-) -> tuple[Perturbation | None, float | None, float | None]:
-    """The perturbation of a robust design and the layer step [units of R], checked."""
-    from metainterface.api.tolerance import layer_step, length_in_r
-
-    if not isinstance(robust, bool):
-        raise MetainterfaceError(f"robust must be True or False, got {robust!r}")
-    radius_m = None if radius is None else parse_length(radius, option="radius")
-    cell = settings or CellSettings()
-    step = None if z_step is None else layer_step(z_step, radius_m, cell.delta_max)
-    if not robust:
-        if any(v not in (0, 0.0) for v in (sigma_h, sigma_gamma, scale_sigma)):
-            raise MetainterfaceError("sigma_h, sigma_gamma and scale_sigma need robust=True")
-        return None, step, radius_m
-    s_h = length_in_r(sigma_h, radius_m, option="sigma_h", radius_option="radius")
-    s_g = _checks.number("sigma_gamma", sigma_gamma, low=0.0)
-    s_s = _checks.number("scale_sigma", scale_sigma, low=0.0, high=0.5)
-    if s_h == s_g == s_s == 0.0:
-        raise MetainterfaceError("robust=True needs sigma_h, sigma_gamma or scale_sigma > 0")
-    k = _checks.whole("robust_samples", robust_samples, low=1, high=MAX_ROBUST_SAMPLES)
-    perturb = Perturbation.draw(
-        cell.n_asperities, k, seed, sigma_h=s_h, sigma_gamma=s_g, scale_sigma=s_s
-    )
-    return perturb, step, radius_m
-
-
-def _robust_stats(
-    r: DesignResult, perturb: Perturbation, seed: int, device: Any = None
-) -> DesignResult:
-    """The result with ``robust``: its nominal error and the distribution of the error of
-    made cells (independent draws), beside the rms error it was refined against."""
-    from metainterface.inverse.tolerance import spread
-
-    d = r.design
-    check = Perturbation.draw(
-        d.n_asperities,
-        ROBUST_REPORT_SAMPLES,
-        seed + 1,
-        sigma_h=perturb.sigma_h,
-        sigma_gamma=perturb.sigma_gamma,
-        scale_sigma=perturb.scale_sigma,
-    )
-    s = spread(
-        d.gamma,
-        d.h,
-        d.settings,
-        r.model,
-        check,
-        target=(r.target.p_star, r.target.alpha),
-        linear=False,
-        device=device,
-    )
-    stats = {
-        "sigma_h": perturb.sigma_h,
-        "sigma_gamma": perturb.sigma_gamma,
-        "scale_sigma": perturb.scale_sigma,
-        "robust_samples": perturb.samples,
-        "error_nominal": r.error,
-        "error_rms_refined": r.robust_error_refined,
-        "error_median": float(np.median(s.errors)),
-        "error_p95": float(np.quantile(s.errors, 0.95)),
-        "check_samples": ROBUST_REPORT_SAMPLES,
-        "check_seed": seed + 1,
-    }
-    return replace(r, robust=stats)
-
-
-def _printable_record(r: DesignResult, radius_m: float | None) -> DesignResult:
-    q = dict(r.printable or {})
-    if radius_m is not None:
-        q["z_step_m"] = q["z_step"] * radius_m
-    q["z_step_units"] = "R"
-    return replace(r, printable=q)
-
-
 def _verify_all(
     results: list[DesignResult],
     checks: Verify,
@@ -419,7 +293,7 @@ def _verify_all(
 ) -> list[DesignResult]:
     """Each result checked (and where asked, corrected) in BEM; a corrected design gets its
     pressure check again."""
-    from metainterface.api.verified import verified
+    from metainterface.designer.verified import verified
 
     out = []
     for r in results:
@@ -475,24 +349,6 @@ def _forced(r: DesignResult, reach: Any) -> DesignResult:
         reach.message.replace("\n", " ")
     )
     return replace(r, forced=True, notes=(note, *r.notes))
-
-
-def _physical_options(radius: Any, modulus: Any, total_force: Any, area: Any) -> dict | None:
-    """Parsed SI options of the physical block, or None without radius and modulus."""
-    if radius is None or modulus is None:
-        if total_force is not None or area is not None:
-            raise MetainterfaceError("total_force and area need radius and modulus too")
-        return None
-    if total_force is not None and area is not None:
-        raise MetainterfaceError("give total_force or area, not both")
-    return {
-        "radius": _physical("radius", parse_length(radius, option="radius")),
-        "e_star": _physical("modulus", parse_pressure(modulus, option="modulus")),
-        "total_force": None
-        if total_force is None
-        else _physical("total_force", parse_force(total_force, option="total_force")),
-        "area": None if area is None else _physical("area", parse_area(area, option="area")),
-    }
 
 
 def _save_all(
@@ -551,228 +407,3 @@ def compare(
                 fig = plot_comparison([per], [[r.curve() for r in per]])
                 save_figure(fig, base / "compare.png", command="compare")
     return by_method  # type: ignore[return-value]
-
-
-def _as_design(
-    design: Design | str | os.PathLike[str] | None,
-    gamma: Any,
-    h: Any,
-    settings: CellSettings | None,
-) -> Design:
-    """A Design from a Design, a design file, or gamma and h lists."""
-    if design is not None:
-        if gamma is not None or h is not None:
-            raise MetainterfaceError("give a design or gamma and h, not both")
-        if isinstance(design, Design):
-            return design
-        if isinstance(design, str | os.PathLike):
-            return Design.load(design)
-        raise MetainterfaceError(
-            f"design must be a Design or a design file path, got {type(design).__name__}"
-        )
-    if gamma is None or h is None:
-        raise MetainterfaceError("give a design, or both gamma and h")
-    if settings is not None and not isinstance(settings, CellSettings):
-        raise MetainterfaceError("settings must be a CellSettings")
-    gamma, h = _checks.vector("gamma", gamma), _checks.vector("h", h)
-    if settings is not None and gamma.size != settings.n_asperities:
-        raise MetainterfaceError(
-            f"gamma has {gamma.size} values but settings.n_asperities is {settings.n_asperities}",
-            argument="gamma",
-        )
-    return Design(gamma=gamma, h=h, settings=settings or CellSettings())
-
-
-def curve(
-    design: Design | str | os.PathLike[str] | None = None,
-    *,
-    gamma: Sequence[float] | np.ndarray | None = None,
-    h: Sequence[float] | np.ndarray | None = None,
-    settings: CellSettings | None = None,
-    model: str | ForwardModel | None = None,
-    steps: int = CURVE_STEPS,
-    smooth: float | None = None,
-    device: str = "auto",
-) -> Curve:
-    """The alpha(P*) and S*(P*) curve of a design along Delta in [0, Delta_max].
-
-    Parameters
-    ----------
-    design : Design or path
-        The design, or a design file; or give ``gamma`` and ``h`` instead.
-    gamma, h : list or array, shape (N,)
-        Shape exponents and height offsets [units of R], N a perfect square.
-    settings : CellSettings
-        The cell of ``gamma`` and ``h`` (default: the paper's).
-    model : str or ForwardModel
-        The forward model (default ``"independent"``).
-    steps : int
-        Delta samples, in [2, 1000000].
-    smooth : float
-        Softplus steepness kappa_s [1/R] instead of the exact bracket, in [1, 1e15].
-    device : str
-        Where the sweep runs: ``"auto"``, ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
-
-    Returns
-    -------
-    Curve
-        numpy ``delta``, ``p_star``, ``alpha``, ``stiffness`` (steps,).
-    """
-    d = _as_design(design, gamma, h, settings)
-    steps = _checks.whole("steps", steps, low=2, high=MAX_STEPS)
-    if smooth is not None:
-        smooth = _checks.number("smooth", smooth, low=SMOOTH_RANGE[0], high=SMOOTH_RANGE[1])
-    dev = resolve_device(device)
-    return design_curve(d, model, steps=steps, smooth=smooth, device=dev)
-
-
-def export(
-    design: Design | str | os.PathLike[str],
-    path: str | os.PathLike[str],
-    *,
-    radius: str | float,
-    tiles: tuple[int, int] | str = (1, 1),
-    format: str | None = None,
-    resolution: float | None = None,
-    base: str | float = "1mm",
-    z_step: str | float | None = None,
-    flank_step: int = 4,
-    force: bool = False,
-) -> dict[str, Any]:
-    """Write the design's surface for manufacture: STL (mm), 16-bit PNG/TIFF or NPY (m).
-
-    Parameters
-    ----------
-    design : Design or path
-    path : path
-        Output file; its suffix picks the format unless ``format`` is given. A sidecar
-        ``path.json`` records the height scale, grid and provenance.
-    radius : str or float
-        Asperity radius R ('0.5mm', or metres).
-    tiles : (nx, ny), 'NXxNY' or 'auto'
-        Cells along x and y; 'auto': the tiling design.json's physical block gives for the
-        area or total force designed for (a design.json path written with them, e.g. by
-        ``design_scale`` or ``metainterface design --area auto``).
-    format : {"stl", "png", "tiff", "npy"}
-    resolution : float
-        Grid points per mm (default 64 per asperity pitch).
-    base : str or float
-        STL base plate thickness under the surface (default 1 mm).
-    z_step : str or float
-        A printer's layer height ('1um', or a plain number in units of R), at most
-        Delta_max: the asperities' height offsets are snapped to its multiples (a design
-        made with ``design(..., z_step=...)`` already sits on them; the sidecar records the
-        largest shift).
-    flank_step : int
-        STL only: the flanks between the asperities' contact zones are meshed on every
-        flank_step-th grid line (default 4; 1 meshes every line), in [1, 64].
-    force : bool
-        Write a file over 100 MB; without it such an export raises an error that states
-        the size and how to make it smaller, and writes nothing.
-
-    Returns
-    -------
-    dict
-        The sidecar record (size, grid, triangles, ...).
-    """
-    from metainterface.io.export import export_design
-
-    check_output_file(path)
-    d = _as_design(design, None, None, None)
-    if isinstance(tiles, str) and tiles.strip().lower() == "auto":
-        tiles = _designed_tiles(design)
-    if resolution is not None:
-        resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
-    radius_m = parse_length(radius, option="radius")
-    _physical("radius", radius_m)
-    source = str(design) if isinstance(design, str | os.PathLike) else None
-    step = None
-    if z_step is not None:
-        from metainterface.api.tolerance import layer_step
-
-        step = layer_step(z_step, radius_m, d.settings.delta_max)
-    flank_step = _checks.whole("flank_step", flank_step, low=1, high=64)
-    if not isinstance(force, bool):
-        raise MetainterfaceError(f"force must be True or False, got {force!r}")
-    notes = (*idle_notes(d), *_cells_note(d, tiles))
-    record = export_design(
-        d,
-        path,
-        z_step=step,
-        radius=radius_m,
-        tiles=tiles,
-        fmt=format,
-        resolution=resolution,
-        base=_checks.number("base", parse_length(base, option="base"), low=1e-6, high=1.0),
-        source=source,
-        flank_step=flank_step,
-        force=force,
-    )
-    return {**record, "notes": list(notes)} if notes else record
-
-
-def _cells_note(d: Design, tiles: Any) -> tuple[str, ...]:
-    """A note when the export's cells are fewer than the design file's physical block says
-    the interface holds."""
-    from metainterface.io.export import parse_tiles
-
-    block = d.extras.get("physical")
-    if not isinstance(block, dict) or "tiles_per_side" not in block:
-        return ()
-    nx, ny = parse_tiles(tiles)
-    per_side = block["tiles_per_side"]
-    if nx >= per_side and ny >= per_side:
-        return ()
-    return (
-        f"this export is {nx}x{ny} unit cells (one cell: {block['cell_side_m'] * 1e3:.4g} mm "
-        f"square, {d.n_asperities} asperities); the design's physical block covers its area "
-        f"with {block['n_cells']:.3g} cells: --tiles {per_side}x{per_side} for the whole patch",
-    )
-def _designed_tiles(design: Any) -> tuple[int, int]:
-    """(n, n) from the physical block of a design.json (tiles='auto')."""
-    import json
-
-    block = None
-    if isinstance(design, str | os.PathLike):
-        try:
-            block = json.loads(Path(design).read_text()).get("physical")
-        except (OSError, ValueError, AttributeError):
-            block = None
-    if not isinstance(block, dict) or "tiles_per_side" not in block:
-        raise MetainterfaceError(
-            "tiles='auto' needs a design.json whose physical block has the tiling (designed "
-            "with radius, modulus and an area or total force); give tiles as (nx, ny)",
-            argument="tiles",
-        )
-    n = int(block["tiles_per_side"])
-    return n, n
-
-
-def physical(
-    design: Design,
-    *,
-    radius: str | float,
-    modulus: str | float,
-    total_force: str | float | None = None,
-    area: str | float | None = None,
-) -> dict[str, Any]:
-    """The design in SI units for an asperity radius and a modulus (paper sec. 2.3): the
-    pressure at P*_max, heights, cell side and, for a total force or an area, the number of
-    unit cells. Keys end in their unit (_m, _m2, _pa, _n)."""
-    opts = _physical_options(radius, modulus, total_force, area)
-    assert opts is not None
-    return physical_block(_as_design(design, None, None, None), **opts)
-
-
-def pressure_check(
-    design: Design, max_pressure: float | str, *, modulus: str | float | None = None
-) -> PressureCheck:
-    """Each asperity's peak contact pressure at Delta_max against a limit (p/E*, or a stress
-    with ``modulus``): which asperities would yield."""
-    limit = _limit(max_pressure, modulus)
-    assert limit is not None
-    d = _as_design(design, None, None, None)
-    if modulus is None:
-        return check_pressure(d, limit)
-    e_star = parse_pressure(modulus, option="modulus")
-    return check_pressure(d, limit * e_star, e_star=e_star)
