@@ -63,7 +63,7 @@ except PackageNotFoundError:  # running from a source tree that was not installe
 #: command line's ``--help`` answers without torch); a name's module is imported on first use
 #: (PEP 562), and ``dir(mi)``, ``help(mi)`` and the API reference still list every name.
 _HOMES: dict[str, str] = {
-    "Curve": "metainterface.designer.results",
+    "Curve": "metainterface.designer.curves",
     "DesignResult": "metainterface.designer.results",
     "PrinterSizing": "metainterface.manufacture.sizing",
     "ToleranceResult": "metainterface.manufacture.tolerance",
@@ -106,8 +106,9 @@ _HOMES: dict[str, str] = {
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
+    from metainterface.designer.curves import Curve
     from metainterface.designer.given import curve, export, physical, pressure_check
-    from metainterface.designer.results import Curve, DesignResult
+    from metainterface.designer.results import DesignResult
     from metainterface.designer.run import compare, design
     from metainterface.designer.scale import design_scale, feasible_scale
     from metainterface.designer.view import view

@@ -4,8 +4,9 @@ compare, curve, export, physical, pressure_check, view, DesignResult, Curve),
 ``manufacture`` (tolerance, min_radius), ``sweep`` (validate, validate_many, write_result)
 and ``surrogate.build`` (generate_dataset, train_surrogate, evaluate_surrogate)."""
 
+from metainterface.designer.curves import Curve
 from metainterface.designer.given import curve, export, physical, pressure_check
-from metainterface.designer.results import Curve, DesignResult
+from metainterface.designer.results import DesignResult
 from metainterface.designer.run import compare, design
 from metainterface.designer.view import view
 from metainterface.manufacture.sizing import PrinterSizing, min_radius

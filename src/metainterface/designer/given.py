@@ -14,12 +14,7 @@ import numpy as np
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_file
-from metainterface.designer.results import (
-    CURVE_STEPS,
-    Curve,
-    design_curve,
-    idle_notes,
-)
+from metainterface.designer.curves import CURVE_STEPS, Curve, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
 from metainterface.physical.dimensions import physical_block
 from metainterface.physical.units import (

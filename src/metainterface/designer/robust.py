@@ -9,9 +9,7 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
-from metainterface.designer.results import (
-    DesignResult,
-)
+from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.perturb import Perturbation
 from metainterface.physical.printer import layer_step, length_in_r

@@ -13,11 +13,9 @@ from typing import Any
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
+from metainterface.designer.curves import reach_note
 from metainterface.designer.given import _limit, _physical_options
-from metainterface.designer.results import (
-    DesignResult,
-    reach_note,
-)
+from metainterface.designer.results import DesignResult
 from metainterface.designer.robust import _manufacturing, _printable_record, _robust_stats
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import pipeline

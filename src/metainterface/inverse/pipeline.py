@@ -14,7 +14,7 @@ import os
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -24,6 +24,7 @@ from torch import Tensor
 from metainterface._device import resolve_device
 from metainterface._names import METHOD_NAMES
 from metainterface.errors import MetainterfaceError
+from metainterface.inverse.designed import DesignResult
 from metainterface.inverse.params import (
     DTYPE,
     FULL,
@@ -52,28 +53,6 @@ if TYPE_CHECKING:  # the surrogate (and its imports) load only when a design nee
 #: Design methods and the parameterisation each refines: the surrogate's prediction and the
 #: multistart in the full space, the Hertz-only baseline with gamma fixed at 2.
 METHODS: dict[str, Parameterisation] = dict(zip(METHOD_NAMES, (FULL, FULL, HERTZ), strict=True))
-
-
-@dataclass(frozen=True)
-class DesignResult:
-    """A designed cell for one target: gamma, h (N,); relative curve error; wall seconds."""
-
-    target: Target
-    method: str
-    gamma: np.ndarray
-    h: np.ndarray
-    error: float
-    seconds: float
-    initial_error: float
-    settings: CellSettings
-    model: ForwardModel = field(default_factory=get_model)
-    start: int = 0  # which start won: 0 = the zero-shot prediction (surrogate) or first start
-    fallback: bool = False  # the design came from the surrogate method's fallback multistart
-    notes: tuple[str, ...] = ()  # what the pipeline decided for the user (e.g. no surrogate)
-    # robust design: the rms relative error over the perturbed copies refined against
-    robust_error: float | None = None
-    # printable heights: errors before the snap to the layer grid, after it, and the step
-    quantisation: dict | None = None
 
 
 def random_starts(

@@ -32,7 +32,7 @@ from metainterface.physics.curves import interp
 from metainterface.physics.models import ForwardModel
 
 if TYPE_CHECKING:
-    from metainterface.inverse.pipeline import DesignResult
+    from metainterface.inverse.designed import DesignResult
 
 DTYPE = torch.float64
 #: Re-seeded starts per design with idle asperities.

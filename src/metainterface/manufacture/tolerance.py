@@ -21,7 +21,8 @@ import numpy as np
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import provenance, strict_json, write_columns, write_text
-from metainterface.designer.results import DesignResult, shown
+from metainterface.designer.curves import shown
+from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import tolerance as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
@@ -174,7 +175,7 @@ class ToleranceResult:
 
     @functools.cached_property
     def _reach(self) -> tuple[float, tuple[int, ...]]:
-        from metainterface.designer.results import reach_counts
+        from metainterface.designer.curves import reach_counts
 
         ref = self.reference
         return reach_counts(
