@@ -22,6 +22,10 @@ Designing
     follow this friction law at this E*, tau and area?), Reachability, UnreachableError,
     feasible_scale (which area, E* or tau makes a friction law reachable, FeasibleScale),
     design_scale (a friction law designed with its area, E* or tau chosen too)
+Design options
+    Effort, Scale, Robust (groups of design's options, built once and reused)
+    design(t, effort=Effort(starts=8), scale=Scale(radius="0.5mm", modulus="2MPa"),
+    robust=Robust(sigma_h="1um")): the search, the user's scale, the printer's errors
 Checked in BEM
     Verify (how design checks, and corrects, each design in BEM), BemCheck (the BEM curve
     and its error to the target: DesignResult.bem)
@@ -83,6 +87,9 @@ _HOMES: dict[str, str] = {
     "view": "metainterface.designer.view",
     "write_result": "metainterface.sweep.validate",
     "design_scale": "metainterface.designer.scale",
+    "Effort": "metainterface.designer.options",
+    "Robust": "metainterface.designer.options",
+    "Scale": "metainterface.designer.options",
     "feasible_scale": "metainterface.designer.scale",
     "MetainterfaceError": "metainterface.errors",
     "UnreachableError": "metainterface.errors",
@@ -108,6 +115,7 @@ _HOMES: dict[str, str] = {
 if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.designer.curves import Curve
     from metainterface.designer.given import curve, export, physical, pressure_check
+    from metainterface.designer.options import Effort, Robust, Scale
     from metainterface.designer.results import DesignResult
     from metainterface.designer.run import compare, design
     from metainterface.designer.scale import design_scale, feasible_scale
@@ -175,6 +183,7 @@ __all__ = [
     "Curve",
     "Design",
     "DesignResult",
+    "Effort",
     "FeasibleScale",
     "ForwardModel",
     "Independent",
@@ -182,6 +191,8 @@ __all__ = [
     "MetainterfaceError",
     "PrinterSizing",
     "Reachability",
+    "Robust",
+    "Scale",
     "Target",
     "ToleranceResult",
     "TrainConfig",

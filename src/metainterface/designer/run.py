@@ -15,6 +15,7 @@ from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
 from metainterface.designer.curves import reach_note
 from metainterface.designer.given import _limit, _physical_options
+from metainterface.designer.options import Effort, Robust, Scale, merge
 from metainterface.designer.results import DesignResult
 from metainterface.designer.robust import _manufacturing, _printable_record, _robust_stats
 from metainterface.errors import MetainterfaceError
@@ -70,118 +71,137 @@ def design(
     targets: Target | str | Sequence[Target | str],
     *,
     method: str = "surrogate",
-    starts: int = 50,
-    hedge: int = 8,
-    fallback: int = 50,
-    seed: int = 0,
     model: str | ForwardModel | None = None,
     settings: CellSettings | None = None,
     surrogate: str | os.PathLike[str] | None = None,
-    refine: bool = True,
+    effort: Effort | None = None,
+    scale: Scale | None = None,
+    robust: bool | Robust = False,
     max_pressure: float | str | None = None,
-    modulus: str | float | None = None,
+    z_step: float | str | None = None,
+    verify: bool | Verify = True,
+    force: bool = False,
+    device: str = "auto",
     out: str | os.PathLike[str] | None = None,
+    full_target: bool = False,
+    meta: dict[str, Any] | None = None,
+    starts: int | None = None,
+    hedge: int | None = None,
+    fallback: int | None = None,
+    refine: bool | None = None,
+    seed: int | None = None,
+    refine_settings: RefineSettings | None = None,
     radius: str | float | None = None,
+    modulus: str | float | None = None,
     total_force: str | float | None = None,
     area: str | float | None = None,
-    meta: dict[str, Any] | None = None,
-    refine_settings: RefineSettings | None = None,
-    full_target: bool = False,
-    robust: bool = False,
-    sigma_h: float | str = 0.0,
-    sigma_gamma: float = 0.0,
-    scale_sigma: float = 0.0,
-    robust_samples: int = 16,
-    z_step: float | str | None = None,
-    device: str = "auto",
-    force: bool = False,
-    verify: bool | Verify = True,
+    sigma_h: float | str | None = None,
+    sigma_gamma: float | None = None,
+    scale_sigma: float | None = None,
+    robust_samples: int | None = None,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target, checked in BEM.
+
+    ``mi.design(t)`` is enough; the options come in groups (built once, reused)::
+
+        mi.design(t, effort=mi.Effort(starts=8, seed=1),
+                  scale=mi.Scale(radius="0.5mm", modulus="2MPa", area="4cm2"),
+                  robust=mi.Robust(sigma_h="1um", samples=8), z_step="10um")
 
     Parameters
     ----------
     targets : Target, str or list of them
-        A target, a built-in name (``"saturating"``, ``"bilinear"``, ``"linear"``), or a list;
-        a list gives a list of results, designed in one batch.
+        A target, a built-in name (``"bilinear"``, ...), or a list (designed in one batch;
+        a list of results back).
     method : {"surrogate", "multistart", "hertz"}
-        Zero-shot prediction by the surrogate then refinement (default), ``starts`` random
-        starts refined and the best kept, or the Hertz-only baseline (gamma = 2, heights only).
-    starts : int
-        Random starts of the multistart and Hertz methods, in [1, 10000].
-    hedge : int
-        Surrogate method: extra starts refined beside the prediction (half jittered copies of
-        it, half random), in [0, 10000]; 0 is the paper's pure pipeline.
-    fallback : int
-        Surrogate method: a target still missed by more than 2 % also gets a multistart with
-        this many starts, the better design kept; 0 turns it off.
-    seed : int
-        Seed of every random draw, in [0, 2**63 - 1]; the same seed gives the same designs.
+        The surrogate's prediction then refinement (default), random starts refined, or the
+        Hertz-only baseline (gamma = 2).
     model : str or ForwardModel
-        The forward model refined and measured with: ``"independent"`` (the paper's,
-        default), ``"interacting"``, or an instance such as ``Interacting(curvature=True)``.
+        Forward model: ``"independent"`` (default), ``"interacting"`` or an instance.
     settings : CellSettings
-        The design space (N, gamma bounds, Delta_max). The shipped surrogate covers the
-        paper's cell; for another one the multistart runs instead (``result.notes``).
+        The design space (N, gamma bounds, Delta_max); the default is the paper's cell.
     surrogate : path
         A surrogate model file (``metainterface train``), default the shipped one.
-    refine : bool
-        Refine the starts (False: the zero-shot prediction or the best raw start).
+    effort : Effort
+        Starts, hedge, fallback, refine, seed and refine_settings (see :class:`Effort`).
+    scale : Scale
+        Radius, modulus, total_force or area in SI (see :class:`Scale`).
+    robust : bool or Robust
+        Design for a printer's errors (see :class:`Robust`).
     max_pressure : float or str
-        A peak contact pressure limit: p/E* in (0, 1], or a stress ('50MPa') with
-        ``modulus``. Adds a penalty to the refinement and a check to each result.
-    modulus : str or float
-        E* of the material pair ('2MPa', or Pa), for ``max_pressure`` and the SI block.
-    out : path
-        Write each result's files here (one target: into ``out``; several: ``out/<name>``).
-    radius, total_force, area : str or float
-        With ``modulus``, ``radius`` R ('0.5mm') adds the design's dimensions in SI to
-        design.json, and the number of cells for a total force ('10N') or an area ('4cm2').
-    meta : dict
-        Extra JSON-ready keys stored in each design.json (e.g. the command line).
-    refine_settings : RefineSettings
-        The refinement's stages, iterations and tolerances (default: the paper's 5 stages x
-        5 steps x 20 iterations, then the polish); fewer make a quicker, rougher design.
-    full_target : bool
-        With ``out``: also write the whole target to target.csv (design.json keeps it
-        decimated to at most 256 points, with its size and hash).
-    robust : bool
-        Design for manufacturing errors: each start is refined against the mean squared
-        error of ``robust_samples`` perturbed copies of it (the same draws for every start,
-        in the same batch), the start with the smallest rms error over them wins.
-        ``result.error`` (and design.json's ``relative_error``) stays the nominal design's;
-        ``result.robust`` holds the nominal and robust statistics.
-    sigma_h, sigma_gamma, scale_sigma : float or str
-        The errors designed for, as in :func:`tolerance`: sigma_h a plain number in units
-        of R or a length ('1um') with ``radius``; sigma_gamma absolute; scale_sigma relative.
-    robust_samples : int
-        K, perturbed copies per start, in [1, 1024]; the cost grows about K-fold.
+        A peak pressure limit: p/E* in (0, 1], or a stress ('50MPa') with a modulus.
     z_step : float or str
-        A printer's layer height: the designed heights are snapped to its multiples and the
-        gammas re-refined with the heights fixed. A plain number in units of R, or a length
-        ('1um') with ``radius``; at most Delta_max. ``result.printable`` reports the error
-        before the snap, after it and after the re-refine.
-    device : str
-        Where the refinement (and the BEM check, with ``verify=True``) runs: ``"auto"``
-        (CUDA when torch sees it, else the CPU), ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
-        Every target's starts go in one batch; the starts are drawn on the CPU, so a seed
-        gives the same starts on every device.
-    force : bool
-        Design a friction-law target that no cell can follow anyway (see
-        :func:`~metainterface.reachability`): the closest cell, marked ``result.forced``.
-        Without it such a target raises :class:`~metainterface.UnreachableError` first.
+        A printer's layer height (units of R, or '1um' with a radius): the heights are
+        snapped to it and the gammas re-refined; ``result.printable`` reports the errors.
     verify : bool or Verify
-        Check each design in the boundary element method and report its error to the
-        target there (``result.bem_error``, ``result.bem``), correcting it in BEM where the
-        BEM adds to the model's error (default True: ``Verify()``, 10 loads on a 384^2 grid
-        for the paper's cell); a ``Verify`` sets the grid, loads, correction and threshold;
-        False skips the check.
+        Check (and correct) each design in BEM (default ``Verify()``); False skips it.
+    force : bool
+        Design a friction law no cell can follow anyway (the closest cell, ``result.forced``);
+        without it such a target raises :class:`~metainterface.UnreachableError`.
+    device : str
+        ``"auto"`` (CUDA when torch sees it), ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
+    out : path
+        Write each result's files here (several targets: ``out/<name>``).
+    full_target, meta
+        With ``out``: also the whole target in target.csv; extra keys for design.json.
+    starts, hedge, fallback, refine, seed, refine_settings
+        One by one, the fields of ``effort``.
+    radius, modulus, total_force, area
+        One by one, the fields of ``scale``.
+    sigma_h, sigma_gamma, scale_sigma, robust_samples
+        One by one, the fields of a ``Robust`` (``robust_samples`` is its ``samples``),
+        with ``robust=True``.
 
     Returns
     -------
     DesignResult or list of DesignResult
         One per target, in order.
     """
+    knobs = merge(
+        effort,
+        Effort,
+        "effort",
+        {
+            "starts": starts,
+            "hedge": hedge,
+            "fallback": fallback,
+            "refine": refine,
+            "seed": seed,
+            "refine_settings": refine_settings,
+        },
+    )
+    starts, hedge, fallback, refine, seed = (
+        knobs["starts"],
+        knobs["hedge"],
+        knobs["fallback"],
+        knobs["refine"],
+        knobs["seed"],
+    )
+    refine_settings = knobs["refine_settings"]
+    size = merge(
+        scale,
+        Scale,
+        "scale",
+        {"radius": radius, "modulus": modulus, "total_force": total_force, "area": area},
+    )
+    radius, modulus, total_force, area = (
+        size["radius"],
+        size["modulus"],
+        size["total_force"],
+        size["area"],
+    )
+    errors = merge(
+        robust if isinstance(robust, Robust) else None,
+        Robust,
+        "robust",
+        {
+            "sigma_h": sigma_h,
+            "sigma_gamma": sigma_gamma,
+            "scale_sigma": scale_sigma,
+            "robust_samples": robust_samples,
+        },
+    )
+    robust = True if isinstance(robust, Robust) else robust
     items, single = _targets(targets)
     if not isinstance(force, bool):
         raise MetainterfaceError(f"force must be True or False, got {force!r}")
@@ -217,7 +237,15 @@ def design(
 
     physical = _physical_options(radius, modulus, total_force, area)
     perturb, step, radius_m = _manufacturing(
-        robust, sigma_h, sigma_gamma, scale_sigma, robust_samples, z_step, radius, settings, seed
+        robust,
+        errors["sigma_h"],
+        errors["sigma_gamma"],
+        errors["scale_sigma"],
+        errors["robust_samples"],
+        z_step,
+        radius,
+        settings,
+        seed,
     )
     raw = pipeline.design(
         items,
@@ -383,12 +411,11 @@ def compare(
         raise MetainterfaceError("compare runs every method; leave method out")
     meta = options.pop("meta", None)
     full_target = options.pop("full_target", False)
-    physical = _physical_options(
-        options.pop("radius", None),
-        options.get("modulus"),
-        options.pop("total_force", None),
-        options.pop("area", None),
-    )
+    given = {k: options.pop(k, None) for k in ("radius", "modulus", "total_force", "area")}
+    size = merge(options.pop("scale", None), Scale, "scale", given)
+    physical = _physical_options(size["radius"], size["modulus"], size["total_force"], size["area"])
+    if size["modulus"] is not None:  # the designs read a stress max_pressure against it
+        options["modulus"] = size["modulus"]
     by_method = {
         m: design(items, method=m, **options)  # type: ignore[misc]
         for m in pipeline.METHODS
