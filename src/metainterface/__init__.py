@@ -83,7 +83,7 @@ _HOMES: dict[str, str] = {
     "tolerance": "metainterface.manufacture.tolerance",
     "train_surrogate": "metainterface.surrogate.build",
     "validate": "metainterface.sweep.validate",
-    "validate_many": "metainterface.sweep.validate",
+    "validate_many": "metainterface.sweep.many",
     "view": "metainterface.designer.view",
     "write_result": "metainterface.sweep.validate",
     "design_scale": "metainterface.designer.scale",
@@ -139,7 +139,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.runtime import tune_allocator
     from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
     from metainterface.surrogate.train import TrainConfig
-    from metainterface.sweep.validate import validate, validate_many, write_result
+    from metainterface.sweep.many import validate_many
+    from metainterface.sweep.validate import validate, write_result
     from metainterface.validation.validate import ValidationResult
     from metainterface.verify.check import BemCheck, Verify
 

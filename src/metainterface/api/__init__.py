@@ -12,7 +12,8 @@ from metainterface.designer.view import view
 from metainterface.manufacture.sizing import PrinterSizing, min_radius
 from metainterface.manufacture.tolerance import ToleranceResult, tolerance
 from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
-from metainterface.sweep.validate import validate, validate_many, write_result
+from metainterface.sweep.many import validate_many
+from metainterface.sweep.validate import validate, write_result
 
 __all__ = [
     "Curve",

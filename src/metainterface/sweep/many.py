@@ -1,0 +1,408 @@
+"""A sweep over many designs (:func:`validate_many`): each design's folder written whole
+(built under a hidden name, then renamed) and ``summary.csv``, one row per finished design,
+after each design; a finished design with the same request is kept, not solved again."""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import csv
+import io
+import json
+import os
+import shutil
+import uuid
+from collections.abc import Sequence
+from concurrent.futures import Executor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from metainterface import _checks
+from metainterface._files import (
+    csv_header,
+    provenance,
+    strict_json,
+    write_text,
+)
+from metainterface._names import DEFAULT_ENGINE
+from metainterface.errors import MetainterfaceError
+from metainterface.io.fields import FIELDS_FILE, require_xarray
+from metainterface.physics.cell import Design
+from metainterface.physics.models import ForwardModel, get_model
+from metainterface.sweep.validate import request_hash, write_result
+from metainterface.validation.bem import (
+    MAX_ITER,
+    TOLERANCE,
+    LoadPath,
+    available_cpus,
+)
+from metainterface.validation.cluster import check_scheduler, dask_executor
+from metainterface.validation.engine import RETRIES, solve_task, stream
+from metainterface.validation.engines import check_engine, get_engine
+from metainterface.validation.validate import (
+    DEFAULT_LOADS,
+    ValidationPlan,
+    check_jobs,
+    plan_validation,
+    solve_batched,
+)
+
+#: Columns of summary.csv, one row per design.
+SUMMARY_COLUMNS = (
+    "name",
+    "status",
+    "max_rel_err_upper_half",
+    "target_error_bem",
+    "target_error_model",
+    "error",
+)
+
+
+def _design_list(designs: Sequence[str | os.PathLike[str] | Design] | str | os.PathLike[str]):
+    """[(name, Design)] from a folder of *.json, a list of files, or Design objects."""
+    if isinstance(designs, str | os.PathLike):
+        folder = Path(designs)
+        if not folder.is_dir():
+            raise MetainterfaceError(f"{folder}: not a folder of design files")
+        # design files in it, or the result folders `design` writes (one design.json each)
+        files = sorted(folder.glob("*.json")) or sorted(folder.glob("*/design.json"))
+        if not files:
+            raise MetainterfaceError(f"{folder}: no design files (*.json or */design.json) in it")
+        designs = files
+    items = list(designs)
+    labels = _file_labels([Path(d) for d in items if not isinstance(d, Design)])
+    out: list[tuple[str, Design]] = []
+    for i, item in enumerate(items):
+        if isinstance(item, Design):
+            out.append((f"design_{i:04d}", item))
+        else:
+            out.append((labels[Path(item)], Design.load(item)))
+    if not out:
+        raise MetainterfaceError("designs: no designs given")
+    names = [n for n, _ in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise MetainterfaceError(f"design names must be unique, repeated: {', '.join(dup)}")
+    return out
+
+
+def _file_labels(paths: list[Path]) -> dict[Path, str]:
+    """A result name per design file: its stem, or its folder for the ``design.json`` that
+    ``design`` writes; where names collide, as many parent folders as make them distinct."""
+
+    def label(p: Path, depth: int) -> str:
+        parents = p.resolve().parent.parts[1:]
+        depth = max(depth, 1) if p.stem == "design" else depth
+        parts = list(parents[len(parents) - depth :]) if depth else []
+        return "-".join(parts if p.stem == "design" and parts else [*parts, p.stem])
+
+    depth = dict.fromkeys(paths, 0)
+    for _ in range(max((len(p.resolve().parts) for p in depth), default=0)):
+        names = {p: label(p, d) for p, d in depth.items()}
+        clash = [p for p, n in names.items() if list(names.values()).count(n) > 1]
+        if not clash:
+            break
+        for p in clash:  # only the colliding names grow
+            depth[p] += 1
+    return {p: label(p, d) for p, d in depth.items()}
+
+
+def _stored(folder: Path, request: dict[str, Any], fields: bool, figure: bool) -> dict | None:
+    """The summary of a finished result made with the same settings (and the files asked
+    for), or None."""
+    try:
+        record = json.loads((folder / "result.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    stored = record.get("request")
+    if isinstance(stored, dict) and "engine" not in stored and request.get("engine") == "tamaas":
+        # results written before there were engines were Tamaas's
+        request = {k: v for k, v in request.items() if k != "engine"}
+    if record.get("request_hash") != request_hash(request) or record.get("request") != request:
+        return None
+    if fields and not (folder / FIELDS_FILE).exists():
+        return None
+    if figure and not (folder / "validation.png").exists():
+        return None
+    return record.get("summary")
+
+
+def _swap_in(staging: Path, final: Path) -> None:
+    """Put a finished folder in place of ``final`` (two renames, no half-written folder)."""
+    if final.exists():
+        old = final.with_name(f".{final.name}.old-{uuid.uuid4().hex[:8]}")
+        os.replace(final, old)
+        os.replace(staging, final)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(staging, final)
+
+
+def _staging(out: Path, name: str) -> Path:
+    return out / f".{name}.partial-{uuid.uuid4().hex[:8]}"
+
+
+def _clear_leftovers(out: Path) -> None:
+    """Remove what a sweep killed while writing leaves: hidden design folders, and the
+    temporary files of summary.csv / summary.json (``atomic_open``'s ``.NAME.*.tmp``)."""
+    if out.is_dir():
+        for leftover in [*out.glob(".*.partial-*"), *out.glob(".*.old-*")]:
+            shutil.rmtree(leftover, ignore_errors=True)
+        for name in ("summary.csv", "summary.json"):
+            for tmp in out.glob(f".{name}.*.tmp"):
+                tmp.unlink(missing_ok=True)
+
+
+def summary_row(name: str, summary: dict[str, Any]) -> dict[str, Any]:
+    """One row of summary.csv: name, status (ok / failed), the largest relative error over
+    the upper half of the loads, the target errors (BEM, model; blank without a target),
+    the error message of a failed design."""
+    if "error" in summary:
+        return {"name": name, "status": "failed", "error": summary["error"]}
+    return {
+        "name": name,
+        "status": "ok",
+        "max_rel_err_upper_half": summary.get("max_rel_err_upper_half"),
+        "target_error_bem": summary.get("target_error_bem"),
+        "target_error_model": summary.get("target_error_model"),
+    }
+
+
+def _cell(value: Any) -> Any:
+    if value is None:
+        return ""
+    return repr(float(value)) if isinstance(value, float) else value  # repr: exact floats
+
+
+def _write_summary(out: Path, rows: list[dict[str, Any]], **settings: Any) -> None:
+    buf = io.StringIO()
+    buf.write(csv_header(**settings))
+    writer = csv.DictWriter(buf, SUMMARY_COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        cells = {k: _cell(v) for k, v in row.items()}
+        # '#' starts a comment for pandas.read_csv(comment="#"): keep messages readable there
+        cells["error"] = str(cells.get("error", "")).replace("#", "no.").replace("\n", " ")
+        writer.writerow(cells)
+    write_text(out / "summary.csv", buf.getvalue())
+
+
+def validate_many(
+    designs: Sequence[str | os.PathLike[str] | Design] | str | os.PathLike[str],
+    out_dir: str | os.PathLike[str],
+    *,
+    grid: int | None = None,
+    loads: int | Sequence[float] | np.ndarray = DEFAULT_LOADS,
+    jobs: int | None = 1,
+    model: str | ForwardModel | None = None,
+    tolerance: float = TOLERANCE,
+    max_iter: int = MAX_ITER,
+    figures: bool = False,
+    fields: bool = False,
+    chunks: int = 1,
+    executor: Executor | None = None,
+    scheduler: str | None = None,
+    retries: int = RETRIES,
+    progress: bool = True,
+    engine: str = DEFAULT_ENGINE,
+    device: str = "auto",
+    batch: int | None = None,
+) -> dict[str, dict[str, Any]]:
+    """Validate many designs against BEM, on local processes or any executor.
+
+    Parameters
+    ----------
+    designs : folder, list of paths or Designs
+        A folder of design files (``*.json``, or the ``*/design.json`` that ``design``
+        writes), a list of files, or Design objects (named ``design_0000``, ...). A file is
+        named by its stem, a ``design.json`` by its folder; colliding names take more of
+        their path.
+    out_dir : path
+        Each design's results go to ``out_dir/<name>/`` (see ``write_result``), written
+        whole as soon as it is done; ``out_dir/summary.csv`` (columns ``SUMMARY_COLUMNS``)
+        and ``summary.json`` are rewritten after each design.
+    grid, loads, model, tolerance, max_iter :
+        As in ``validate``, for every design.
+    jobs : int
+        Local processes (default 1: in this process; None: the cores), or the workers of
+        ``scheduler="local"``.
+    figures, fields : bool
+        Also write validation.png / fields.nc for every design.
+    chunks : int
+        Split each design's load path into this many warm-started tasks (for fewer designs
+        than workers); default one task per design.
+    executor : concurrent.futures.Executor
+        Run the tasks there: ``dask.distributed.Client(...).get_executor()``,
+        ``mpi4py.futures.MPIPoolExecutor()``, a dask-jobqueue cluster's client, ...
+    scheduler : str
+        Or a Dask scheduler: ``"tcp://HOST:PORT"`` joins a running cluster, ``"local"``
+        starts a LocalCluster of ``jobs`` processes (the ``distributed`` extra).
+    retries : int
+        Times a task lost by the engine (a worker that died) is submitted again.
+    progress : bool
+        A progress bar over the designs.
+    engine, device : str
+        The contact solver and where torch runs, as in ``validate``. The engine is part of
+        each stored request: a sweep resumed with another engine solves its designs again.
+    batch : int
+        Designs of one grid size the torch engine solves together, in this process (no
+        executor, ``chunks=1``). Default: as many as a GPU's memory holds on a GPU, 1 on the
+        CPU (where a batch is no faster).
+
+    Returns
+    -------
+    dict
+        {name: summary}; a failed design's summary has an "error" key (and its folder an
+        error.txt).
+
+    Notes
+    -----
+    A design whose result.json records the same request (design, grid, loads, model,
+    solver settings; compared by hash) and has the files asked for is skipped, so a sweep
+    that was interrupted, or that lost its engine, resumes where it stopped. A design that
+    fails (e.g. no convergence) gets error.txt and the sweep goes on; it is tried again on
+    the next run.
+    """
+    solver = check_engine(engine, device)
+    jobs = available_cpus() if jobs is None else check_jobs(jobs)
+    if executor is None and scheduler is None and solver.name == "torch" and jobs > 1:
+        from metainterface._device import resolve_device
+
+        if resolve_device(device).type == "cuda":
+            jobs = 1  # one process drives the GPU (a forked child cannot use CUDA)
+    chunks = _checks.whole("chunks", chunks, low=1, high=10_000)
+    retries = _checks.whole("retries", retries, low=0, high=100)
+    if fields:
+        require_xarray()
+    if executor is not None and scheduler is not None:
+        raise MetainterfaceError("give executor or scheduler, not both")
+    if scheduler is not None:
+        check_scheduler(scheduler)
+    here = executor is None and scheduler is None and chunks == 1 and solver.name == "torch"
+    if batch is not None:
+        batch = _checks.whole("batch", batch, low=1, high=1024)
+        if batch > 1 and not here:
+            raise MetainterfaceError(
+                "batch > 1 needs engine='torch' solving in this process (no executor or "
+                "scheduler, chunks=1)",
+                argument="batch",
+            )
+    out = Path(out_dir)
+    items = _design_list(designs)
+    summaries: dict[str, dict[str, Any]] = {}
+    todo: list[ValidationPlan] = []
+    for name, design in items:
+        try:
+            prep = plan_validation(
+                design,
+                name=name,
+                grid=grid,
+                loads=loads,
+                model=model,
+                tolerance=tolerance,
+                max_iter=max_iter,
+                engine=engine,
+                device=device,
+            )
+        except MetainterfaceError as exc:
+            raise MetainterfaceError(f"{name}: {exc}") from None
+        done = _stored(out / name, prep.request(), fields, figures)
+        if done is not None:
+            summaries[name] = done
+        else:
+            todo.append(prep)
+    _clear_leftovers(out)
+    sweep = {
+        "command": "validate_many",
+        "grid": grid,
+        "loads": loads if isinstance(loads, int) else [float(p) for p in loads],
+        "model": get_model(model).label,
+        "tolerance": tolerance,
+        "max_iter": max_iter,
+        "engine": get_engine(engine).name,
+    }
+
+    def write_summary() -> None:
+        ordered = {n: summaries[n] for n, _ in items if n in summaries}
+        _write_summary(out, [summary_row(n, s) for n, s in ordered.items()], **sweep)
+        record = {"designs": ordered, "provenance": provenance(**sweep)}
+        write_text(out / "summary.json", strict_json.dumps(record, indent=2) + "\n")
+
+    # one design's chunks: (design index in todo, its tasks); flat list for the engine
+    tasks, owner = [], []
+    # in this process (no executor, one job) torch keeps its threads; workers run on one
+    threads = None if executor is None and scheduler is None and jobs <= 1 else 1
+    for d, prep in enumerate(todo):
+        for task in prep.tasks(chunks, fields=fields, threads=threads):
+            tasks.append(task)
+            owner.append(d)
+    parts: dict[int, dict[int, LoadPath]] = {d: {} for d in range(len(todo))}
+    failed: set[int] = set()
+    n_chunks = collections.Counter(owner)
+
+    bar: Any = None
+
+    def on_done(i: int, part: LoadPath) -> None:
+        d = owner[i]
+        if d in failed:
+            return
+        parts[d][i] = part
+        if len(parts[d]) < n_chunks[d]:
+            return
+        prep = todo[d]
+        path = LoadPath.concat([parts[d][j] for j in sorted(parts[d])])
+        parts[d].clear()
+        result = prep.result(path)
+        staging = _staging(out, prep.name)
+        write_result(result, staging, figure=figures, command="validate_many")
+        _swap_in(staging, out / prep.name)
+        summaries[prep.name] = result.summary()
+        write_summary()
+        if bar is not None:
+            bar.update(1)
+
+    def on_error(i: int, exc: BaseException) -> None:
+        d = owner[i]
+        if d in failed:
+            return
+        failed.add(d)
+        parts[d].clear()
+        prep = todo[d]
+        staging = _staging(out, prep.name)
+        write_text(staging / "error.txt", f"{exc}\n")
+        _swap_in(staging, out / prep.name)
+        summaries[prep.name] = {"name": prep.name, "error": str(exc)}
+        write_summary()
+        if bar is not None:
+            bar.update(1)
+
+    if batch is None:
+        batch = 1
+        if here and todo:
+            from metainterface._device import resolve_device
+            from metainterface.validation.torch_bem import batch_size
+
+            batch = batch_size(todo[0].grid, resolve_device(device))
+    with contextlib.ExitStack() as stack:
+        if scheduler is not None and tasks:  # joined first: a bad address fails before the bar
+            executor = stack.enter_context(dask_executor(scheduler, jobs))
+        if progress and todo:
+            from tqdm.auto import tqdm
+
+            bar = stack.enter_context(tqdm(total=len(todo), desc="designs", unit="design"))
+        if batch > 1:  # one task per design: task i is design i
+            solve_batched(todo, batch, fields=fields, on_done=on_done, on_error=on_error)
+        else:
+            stream(
+                solve_task,
+                tasks,
+                executor=executor,
+                jobs=jobs,
+                on_done=on_done,
+                on_error=on_error,
+                retries=retries,
+            )
+    write_summary()
+    return {n: summaries[n] for n, _ in items}
