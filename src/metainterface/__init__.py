@@ -106,7 +106,7 @@ _HOMES: dict[str, str] = {
     "register_model": "metainterface.physics.models",
     "tune_allocator": "metainterface.runtime",
     "TrainConfig": "metainterface.surrogate.train",
-    "ValidationResult": "metainterface.validation.validate",
+    "ValidationResult": "metainterface.validation.result",
     "FeasibleScale": "metainterface.inverse.scale",
     "BemCheck": "metainterface.verify.check",
     "Verify": "metainterface.verify.check",
@@ -141,7 +141,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.surrogate.train import TrainConfig
     from metainterface.sweep.many import validate_many
     from metainterface.sweep.validate import validate, write_result
-    from metainterface.validation.validate import ValidationResult
+    from metainterface.validation.result import ValidationResult
     from metainterface.verify.check import BemCheck, Verify
 
 

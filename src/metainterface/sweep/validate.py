@@ -49,11 +49,10 @@ from metainterface.validation.bem import (
 )
 from metainterface.validation.cluster import check_scheduler, dask_executor
 from metainterface.validation.engines import check_engine, get_engine
+from metainterface.validation.result import ValidationResult, design_target
 from metainterface.validation.validate import (
     DEFAULT_LOADS,
-    ValidationResult,
     check_jobs,
-    design_target,
     plan_validation,
     validation_request,
 )
