@@ -181,11 +181,12 @@ def reach_counts(
     """(coverage, idle) of a design against a target's (p_star, alpha), under a model.
 
     coverage: the fraction of the target's load range the design reaches
-    (:func:`~metainterface.physics.curves.coverage`; 1.0 without a target). idle: indices
+    (:func:`~metainterface.physics.metrics.coverage`; 1.0 without a target). idle: indices
     of the asperities that carry no load, never touching within Delta_max or, with a
     target, only past its largest load (:func:`~metainterface.physics.curves.idle_mask`).
     """
-    from metainterface.physics.curves import coverage, idle_mask
+    from metainterface.physics.curves import idle_mask
+    from metainterface.physics.metrics import coverage
 
     m = get_model(model)
     gamma, h = design.tensors(torch.float64)

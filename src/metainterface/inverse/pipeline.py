@@ -43,8 +43,8 @@ from metainterface.inverse.refine import (
 from metainterface.inverse.starts import best_views, hedge_starts, predict, random_starts
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import alpha_at
 from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.pressures import alpha_at
 
 #: Design methods and the parameterisation each refines: the surrogate's prediction and the
 #: multistart in the full space, the Hertz-only baseline with gamma fixed at 2.

@@ -28,7 +28,7 @@ from torch import Tensor
 from metainterface.inverse.params import FULL
 from metainterface.inverse.refine import RefineSettings, TargetGrid, polish, refine, relative_error
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import interp
+from metainterface.physics.metrics import interp
 from metainterface.physics.models import ForwardModel
 
 if TYPE_CHECKING:

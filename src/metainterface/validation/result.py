@@ -114,7 +114,7 @@ class ValidationResult:
         return float(np.abs(self.alpha_bem_pixels / self.alpha_model - 1.0)[self.upper_half].max())
 
     def target_error(self, alpha: np.ndarray) -> float | None:
-        """The package's curve error (``physics.curves.curve_error``) of
+        """The package's curve error (``physics.metrics.curve_error``) of
         alpha (K,), measured at this result's loads, against the design's target; or None
         without a target.
 
@@ -206,7 +206,7 @@ def _grid_error(
 ) -> float:
     """curve_error on the target's ERROR_POINTS grid of the model's exact alpha times
     ``ratio`` (K,) interpolated in the ``loads`` (K,), held at the ends."""
-    from metainterface.physics.curves import curve_error
+    from metainterface.physics.metrics import curve_error
 
     p_t, a_t = target
     grid = np.linspace(0.0, float(p_t[-1]), ERROR_POINTS)
