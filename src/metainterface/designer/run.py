@@ -217,7 +217,7 @@ def design(
     seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
     n = (settings or CellSettings()).n_asperities
     dev = resolve_device(device)
-    _affordable_rows(method, starts, hedge, fallback, len(items), n, dev)
+    affordable_rows(method, starts, hedge, fallback, len(items), n, dev)
     if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
         raise MetainterfaceError("refine_settings must be a RefineSettings")
     if not isinstance(refine, bool):
@@ -281,7 +281,7 @@ def design(
     return results[0] if single else results
 
 
-def _affordable_rows(
+def affordable_rows(
     method: str, starts: int, hedge: int, fallback: int, targets: int, n: int, device: Any
 ) -> None:
     """Refuse a design whose largest batch would not fit in memory (the GPU's on CUDA).
