@@ -16,7 +16,9 @@ import numpy as np
 import torch
 
 from metainterface.data import load_dataset
-from metainterface.physics.curves import alpha_at, curve, relative_l2
+from metainterface.physics.curves import curve
+from metainterface.physics.metrics import relative_l2
+from metainterface.physics.pressures import alpha_at
 from metainterface.surrogate.checkpoint import default_model_path, load_model
 from metainterface.surrogate.data import split_of
 

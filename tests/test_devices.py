@@ -180,13 +180,13 @@ def test_many_targets_pass_the_memory_check(monkeypatch):
     """The check counts the rows refined together: the surrogate's 1 + hedge per target,
     or its fallback's starts afterwards, not their sum with ``starts``."""
     from metainterface import _checks
-    from metainterface.api.functions import _affordable_rows
+    from metainterface.designer.run import affordable_rows
 
     monkeypatch.setattr(_checks, "memory_total", lambda: 16 * 2**30)
     cpu = torch.device("cpu")
-    _affordable_rows("surrogate", 50, 8, 50, 1000, 9, cpu)  # 7.4 GB: under 8 GiB
+    affordable_rows("surrogate", 50, 8, 50, 1000, 9, cpu)  # 7.4 GB: under 8 GiB
     with pytest.raises(MetainterfaceError, match=r"starts = 50 .* for 10000 targets") as e:
-        _affordable_rows("multistart", 50, 8, 50, 10_000, 9, cpu)
+        affordable_rows("multistart", 50, 8, 50, 10_000, 9, cpu)
     assert "\n" not in str(e.value)
 
 

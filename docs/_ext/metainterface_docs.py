@@ -8,7 +8,7 @@ reproduced figures from ``docs/figures``, and references to public names by any 
   appears without anyone editing the docs; a public name without a docstring is a warning,
   and so (with ``-W``) a failed build.
 * ``missing-reference``: autodoc writes type hints with the defining module
-  (``metainterface.api.results.DesignResult``); such a reference resolves to the public
+  (``metainterface.designer.results.DesignResult``); such a reference resolves to the public
   name (``metainterface.DesignResult``) when that is the same object.
 * The ``reproduced-figures`` directive shows every PNG of a folder with its caption ``.txt``
   (what ``metainterface reproduce`` writes), in the order of its ``results.md``.

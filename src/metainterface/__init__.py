@@ -22,6 +22,10 @@ Designing
     follow this friction law at this E*, tau and area?), Reachability, UnreachableError,
     feasible_scale (which area, E* or tau makes a friction law reachable, FeasibleScale),
     design_scale (a friction law designed with its area, E* or tau chosen too)
+Design options
+    Effort, Scale, Robust (groups of design's options, built once and reused)
+    design(t, effort=Effort(starts=8), scale=Scale(radius="0.5mm", modulus="2MPa"),
+    robust=Robust(sigma_h="1um")): the search, the user's scale, the printer's errors
 Checked in BEM
     Verify (how design checks, and corrects, each design in BEM), BemCheck (the BEM curve
     and its error to the target: DesignResult.bem)
@@ -63,31 +67,34 @@ except PackageNotFoundError:  # running from a source tree that was not installe
 #: command line's ``--help`` answers without torch); a name's module is imported on first use
 #: (PEP 562), and ``dir(mi)``, ``help(mi)`` and the API reference still list every name.
 _HOMES: dict[str, str] = {
-    "Curve": "metainterface.api",
-    "DesignResult": "metainterface.api",
-    "PrinterSizing": "metainterface.api",
-    "ToleranceResult": "metainterface.api",
-    "compare": "metainterface.api",
-    "curve": "metainterface.api",
-    "design": "metainterface.api",
-    "evaluate_surrogate": "metainterface.api",
-    "export": "metainterface.api",
-    "generate_dataset": "metainterface.api",
-    "min_radius": "metainterface.api",
-    "physical": "metainterface.api",
-    "pressure_check": "metainterface.api",
-    "tolerance": "metainterface.api",
-    "train_surrogate": "metainterface.api",
-    "validate": "metainterface.api",
-    "validate_many": "metainterface.api",
-    "view": "metainterface.api",
-    "write_result": "metainterface.api",
-    "design_scale": "metainterface.api.scale",
-    "feasible_scale": "metainterface.api.scale",
+    "Curve": "metainterface.designer.curves",
+    "DesignResult": "metainterface.designer.results",
+    "PrinterSizing": "metainterface.manufacture.sizing",
+    "ToleranceResult": "metainterface.manufacture.tolerance",
+    "compare": "metainterface.designer.run",
+    "curve": "metainterface.designer.given",
+    "design": "metainterface.designer.run",
+    "evaluate_surrogate": "metainterface.surrogate.build",
+    "export": "metainterface.designer.given",
+    "generate_dataset": "metainterface.surrogate.build",
+    "min_radius": "metainterface.manufacture.sizing",
+    "physical": "metainterface.designer.given",
+    "pressure_check": "metainterface.designer.given",
+    "tolerance": "metainterface.manufacture.tolerance",
+    "train_surrogate": "metainterface.surrogate.build",
+    "validate": "metainterface.sweep.validate",
+    "validate_many": "metainterface.sweep.many",
+    "view": "metainterface.designer.view",
+    "write_result": "metainterface.sweep.validate",
+    "design_scale": "metainterface.designer.scale",
+    "Effort": "metainterface.designer.options",
+    "Robust": "metainterface.designer.options",
+    "Scale": "metainterface.designer.options",
+    "feasible_scale": "metainterface.designer.scale",
     "MetainterfaceError": "metainterface.errors",
     "UnreachableError": "metainterface.errors",
     "Reachability": "metainterface.physical.reach",
-    "reachability": "metainterface.api.reach",
+    "reachability": "metainterface.inverse.reach",
     "Target": "metainterface.inverse.targets",
     "CellSettings": "metainterface.physics.cell",
     "Design": "metainterface.physics.cell",
@@ -99,39 +106,26 @@ _HOMES: dict[str, str] = {
     "register_model": "metainterface.physics.models",
     "tune_allocator": "metainterface.runtime",
     "TrainConfig": "metainterface.surrogate.train",
-    "ValidationResult": "metainterface.validation.validate",
+    "ValidationResult": "metainterface.validation.result",
     "FeasibleScale": "metainterface.inverse.scale",
     "BemCheck": "metainterface.verify.check",
     "Verify": "metainterface.verify.check",
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
-    from metainterface.api import (
-        Curve,
-        DesignResult,
-        PrinterSizing,
-        ToleranceResult,
-        compare,
-        curve,
-        design,
-        evaluate_surrogate,
-        export,
-        generate_dataset,
-        min_radius,
-        physical,
-        pressure_check,
-        tolerance,
-        train_surrogate,
-        validate,
-        validate_many,
-        view,
-        write_result,
-    )
-    from metainterface.api.reach import reachability
-    from metainterface.api.scale import design_scale, feasible_scale
+    from metainterface.designer.curves import Curve
+    from metainterface.designer.given import curve, export, physical, pressure_check
+    from metainterface.designer.options import Effort, Robust, Scale
+    from metainterface.designer.results import DesignResult
+    from metainterface.designer.run import compare, design
+    from metainterface.designer.scale import design_scale, feasible_scale
+    from metainterface.designer.view import view
     from metainterface.errors import MetainterfaceError, UnreachableError
+    from metainterface.inverse.reach import reachability
     from metainterface.inverse.scale import FeasibleScale
     from metainterface.inverse.targets import Target
+    from metainterface.manufacture.sizing import PrinterSizing, min_radius
+    from metainterface.manufacture.tolerance import ToleranceResult, tolerance
     from metainterface.physical.reach import Reachability
     from metainterface.physics.cell import CellSettings, Design
     from metainterface.physics.models import (
@@ -143,8 +137,11 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         register_model,
     )
     from metainterface.runtime import tune_allocator
+    from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
     from metainterface.surrogate.train import TrainConfig
-    from metainterface.validation.validate import ValidationResult
+    from metainterface.sweep.many import validate_many
+    from metainterface.sweep.validate import validate, write_result
+    from metainterface.validation.result import ValidationResult
     from metainterface.verify.check import BemCheck, Verify
 
 
@@ -187,6 +184,7 @@ __all__ = [
     "Curve",
     "Design",
     "DesignResult",
+    "Effort",
     "FeasibleScale",
     "ForwardModel",
     "Independent",
@@ -194,6 +192,8 @@ __all__ = [
     "MetainterfaceError",
     "PrinterSizing",
     "Reachability",
+    "Robust",
+    "Scale",
     "Target",
     "ToleranceResult",
     "TrainConfig",

@@ -109,7 +109,7 @@ def test_fallback_multistart_for_targets_the_surrogate_misses():
 
 
 def test_random_starts_are_nested_and_the_same_for_every_target():
-    from metainterface.inverse.pipeline import random_starts
+    from metainterface.inverse.starts import random_starts
 
     g8, h8 = random_starts(8, 3, S, seed=5, param=FULL)
     g3, h3 = random_starts(3, 1, S, seed=5, param=FULL)
@@ -133,7 +133,7 @@ def test_a_targets_design_does_not_depend_on_the_batch(method):
 
 
 def test_hedge_starts_jitter_the_zero_shot_design():
-    from metainterface.inverse.pipeline import JITTER_GAMMA, hedge_starts, random_starts
+    from metainterface.inverse.starts import JITTER_GAMMA, hedge_starts, random_starts
 
     g0 = torch.full((2, 9), 3.0, dtype=torch.float64)
     h0 = torch.linspace(0, 0.5 * S.delta_max, 9, dtype=torch.float64).expand(2, 9)

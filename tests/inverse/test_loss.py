@@ -6,7 +6,7 @@ from metainterface.inverse import builtin_target
 from metainterface.inverse.params import FULL
 from metainterface.inverse.refine import InterpolatedLoss, TargetGrid, masked_loss
 from metainterface.physics import CellSettings
-from metainterface.physics.curves import alpha_at
+from metainterface.physics.pressures import alpha_at
 
 F64 = torch.float64
 

@@ -4,7 +4,7 @@ import numpy as np
 import torch
 
 import metainterface as mi
-from metainterface.inverse import pipeline
+from metainterface.inverse import pipeline, starts
 from metainterface.inverse.targets import design_targets, target_features
 from metainterface.surrogate.checkpoint import default_model_path, load_model
 
@@ -23,8 +23,8 @@ def test_constant_training_inputs_are_set_to_their_constant():
     bare = mi.Target(p_star=t.p_star, alpha=t.alpha, name="bare")
     raw = target_features(bare)
     assert raw[128] > 0  # S* at P* = 0 by finite differences, where training always had 0
-    x = pipeline.conform(net, raw)
-    fixed = net.in_std < pipeline.CONSTANT_STD
+    x = starts.conform(net, raw)
+    fixed = net.in_std < starts.CONSTANT_STD
     assert fixed.sum() >= 1
     np.testing.assert_array_equal(x[0, fixed].numpy(), net.in_mean[fixed].double().numpy())
     np.testing.assert_array_equal(x[0, ~fixed].numpy(), raw[~fixed].double().numpy())
@@ -45,16 +45,16 @@ def test_cell_curves_without_stiffness_read_like_with_it():
 def test_views_of_a_law_never_make_the_prediction_worse():
     p = np.linspace(0.0, 2e-3, 40)
     law = mi.Target(p_star=p, alpha=0.05 * (1 - np.exp(-p / 6e-4)), name="law")
-    views = pipeline.target_views(law)
-    assert len(views) == len(pipeline.EXTEND_VIEWS) + len(pipeline.CUT_VIEWS)
+    views = starts.target_views(law)
+    assert len(views) == len(starts.EXTEND_VIEWS) + len(starts.CUT_VIEWS)
     ends = sorted(v.p_star_max / law.p_star_max for v in views)
     assert ends[0] < 1 < ends[-1]
     for v in views:  # every view keeps the law where it overlaps
         k = min(v.p_star.size, p.size)
         np.testing.assert_allclose(v.alpha[:k], law.alpha[:k])
     net, settings, _ = load_model(default_model_path())
-    g0, h0 = pipeline.predict(net, [law], settings)
-    g1, h1 = pipeline.best_views(net, [law], g0, h0, settings, mi.get_model("independent"), 128)
+    g0, h0 = starts.predict(net, [law], settings)
+    g1, h1 = starts.best_views(net, [law], g0, h0, settings, mi.get_model("independent"), 128)
     grid = pipeline.TargetGrid.from_curves([(law.p_star, law.alpha)], 128)
     e0 = pipeline.relative_error(g0, h0, settings, grid)
     e1 = pipeline.relative_error(g1, h1, settings, grid)

@@ -8,7 +8,8 @@ import pytest
 import torch
 
 import metainterface as mi
-from metainterface.physics.curves import coverage, curve_error, idle_mask
+from metainterface.physics.curves import idle_mask
+from metainterface.physics.metrics import coverage, curve_error
 
 
 def test_curve_error_closed_forms():

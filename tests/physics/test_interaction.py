@@ -7,7 +7,15 @@ import pytest
 import torch
 
 from metainterface.errors import MetainterfaceError
-from metainterface.physics import CellSettings, Design, curve, curves, interp, kappa, sweep
+from metainterface.physics import (
+    CellSettings,
+    Design,
+    curve,
+    interp,
+    kappa,
+    pressures,
+    sweep,
+)
 from metainterface.physics.interaction import (
     interaction,
     load_area_interacting,
@@ -340,7 +348,7 @@ def test_alpha_at_matches_the_design_convention():
     g, h = random_designs(3, seed=9)
     p = torch.linspace(0, 0.004, 50, dtype=F64)[None].expand(3, -1)
     a, p_max = Independent().alpha_at(g, h, S, p)
-    ref = curves.alpha_at(g, h, S, p)
+    ref = pressures.alpha_at(g, h, S, p)
     np.testing.assert_array_equal(a, ref[0])
     np.testing.assert_array_equal(p_max, ref[1])
     a, p_max = Interacting().alpha_at(g, h, S, p)

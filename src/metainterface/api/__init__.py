@@ -1,11 +1,19 @@
-"""The public API: what ``import metainterface as mi`` offers (re-exported there)."""
+"""The public API gathered in one place (``import metainterface as mi`` offers the same
+names, imported lazily). Each name lives in the room of its concern: ``designer`` (design,
+compare, curve, export, physical, pressure_check, view, DesignResult, Curve),
+``manufacture`` (tolerance, min_radius), ``sweep`` (validate, validate_many, write_result)
+and ``surrogate.build`` (generate_dataset, train_surrogate, evaluate_surrogate)."""
 
-from metainterface.api.functions import compare, curve, design, export, physical, pressure_check
-from metainterface.api.results import Curve, DesignResult
-from metainterface.api.tolerance import PrinterSizing, ToleranceResult, min_radius, tolerance
-from metainterface.api.training import evaluate_surrogate, generate_dataset, train_surrogate
-from metainterface.api.validation_files import validate, validate_many, write_result
-from metainterface.api.view import view
+from metainterface.designer.curves import Curve
+from metainterface.designer.given import curve, export, physical, pressure_check
+from metainterface.designer.results import DesignResult
+from metainterface.designer.run import compare, design
+from metainterface.designer.view import view
+from metainterface.manufacture.sizing import PrinterSizing, min_radius
+from metainterface.manufacture.tolerance import ToleranceResult, tolerance
+from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
+from metainterface.sweep.many import validate_many
+from metainterface.sweep.validate import validate, write_result
 
 __all__ = [
     "Curve",

@@ -275,7 +275,7 @@ def _advise(args: argparse.Namespace, name: str) -> None:
 def _design_scale(args: argparse.Namespace, options: dict) -> list:
     """--friction-csv with a free area, modulus or shear strength: the scale designed too."""
     import metainterface as mi
-    from metainterface.api.scale import scale_line
+    from metainterface.designer.scale import scale_line
 
     if args.target or args.target_csv or args.compare:
         raise mi.MetainterfaceError(
@@ -493,8 +493,8 @@ def _bem_legend(results: list) -> str:
 def _manufacturing(args: argparse.Namespace) -> dict:
     """The robust-design and layer options, lengths in units of R (errors name the options)."""
     import metainterface as mi
-    from metainterface.api.tolerance import layer_step, length_in_r
     from metainterface.physical import parse_length
+    from metainterface.physical.printer import layer_step, length_in_r
 
     radius = None if args.radius is None else parse_length(args.radius, option="--radius")
     out: dict = {}

@@ -27,8 +27,9 @@ from metainterface.inverse import lbfgs, levmar
 from metainterface.inverse.params import DTYPE, FULL, Parameterisation
 from metainterface.inverse.perturb import Perturbation, loaded
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import at_delta, curve_error, interp_weights, solve_delta
+from metainterface.physics.metrics import curve_error, interp_weights
 from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.pressures import at_delta, solve_delta
 
 POLISH_METHODS = ("levmar", "lbfgs")
 
@@ -261,7 +262,7 @@ def relative_error(
     target: TargetGrid,
     model: ForwardModel | None = None,
 ) -> Tensor:
-    """The package's curve error (:func:`~metainterface.physics.curves.curve_error`) on the
+    """The package's curve error (:func:`~metainterface.physics.metrics.curve_error`) on the
     target's grid: the relative L2 error where the design reaches (exact law, alpha exact
     at the target's pressures), combined with the share of the load range it misses. (B,)."""
     with torch.no_grad():

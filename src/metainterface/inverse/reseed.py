@@ -28,11 +28,11 @@ from torch import Tensor
 from metainterface.inverse.params import FULL
 from metainterface.inverse.refine import RefineSettings, TargetGrid, polish, refine, relative_error
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import interp
+from metainterface.physics.metrics import interp
 from metainterface.physics.models import ForwardModel
 
 if TYPE_CHECKING:
-    from metainterface.inverse.pipeline import DesignResult
+    from metainterface.inverse.designed import DesignResult
 
 DTYPE = torch.float64
 #: Re-seeded starts per design with idle asperities.

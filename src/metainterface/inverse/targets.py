@@ -29,7 +29,8 @@ import torch
 from metainterface._files.columns import read_columns
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import at_pressures, sweep
+from metainterface.physics.curves import sweep
+from metainterface.physics.pressures import at_pressures
 
 
 @dataclass(frozen=True, repr=False)
@@ -185,7 +186,7 @@ def design_targets(
 ) -> list[Target]:
     """The exact curves of (B, N) designs (h in units of R) as targets, one per name: alpha
     and S* at ``points`` uniform pressures on [0, P*_max], exact to round-off (the pressure
-    is solved for, :func:`~metainterface.physics.curves.at_pressures`)."""
+    is solved for, :func:`~metainterface.physics.pressures.at_pressures`)."""
     s = settings or CellSettings()
     gamma, h = gamma.to(torch.float64), h.to(torch.float64)
     if len(names) != gamma.shape[0] or gamma.shape != h.shape or gamma.dim() != 2:

@@ -12,7 +12,7 @@ with sigma_h in units of R. Heights are anchored by the forward model: Delta is 
 from the first contact of the made part, so only relative height errors matter. The scale
 error scales the height offsets only; the tips' own shapes carry the gamma error.
 
-Errors are the package's curve error (:func:`~metainterface.physics.curves.curve_error`,
+Errors are the package's curve error (:func:`~metainterface.physics.metrics.curve_error`,
 exact alpha at the reference's pressures), with one difference from ``design``'s: a made
 cell that needs a deeper indentation than Delta_max to reach a pressure is loaded further
 (up to ``REACH`` Delta_max) instead of having its alpha held at its last value, since
@@ -37,7 +37,7 @@ from metainterface.inverse.params import DTYPE
 from metainterface.inverse.perturb import Perturbation, loaded
 from metainterface.inverse.refine import TargetGrid, relative_error
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import curve_error
+from metainterface.physics.metrics import curve_error
 from metainterface.physics.models import ForwardModel
 
 #: Bisection steps (in log sigma_h) of the radius search: the bracket [1e-6, 10] Delta_max,

@@ -30,7 +30,7 @@ from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
 
 if TYPE_CHECKING:
-    from metainterface.validation.validate import ValidationResult
+    from metainterface.validation.result import ValidationResult
 
 FIELDS_HINT = "pip install 'metainterface[fields]'"
 FIELDS_FILE = "fields.nc"

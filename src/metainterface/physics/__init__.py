@@ -4,20 +4,17 @@ from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.curves import (
     Curve,
     Sweep,
-    alpha_at,
     anchor,
-    coverage,
     curve,
-    curve_error,
     curves_numpy,
     delta_grid,
     design_sweep,
     features_from_normalised,
     idle_mask,
-    interp,
     sweep,
     to_grid,
 )
+from metainterface.physics.metrics import coverage, curve_error, interp
 from metainterface.physics.models import (
     DEFAULT_MODEL,
     MODELS,
@@ -29,6 +26,7 @@ from metainterface.physics.models import (
     models_at,
     register_model,
 )
+from metainterface.physics.pressures import alpha_at
 from metainterface.physics.sneddon import (
     area,
     contact_radius,

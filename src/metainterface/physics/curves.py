@@ -8,16 +8,16 @@ alpha = A_tot / A_nom, S* = dP*/dalpha.
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import torch
 from torch import Tensor
 
 from metainterface.physics.cell import CellSettings, Design
+from metainterface.physics.metrics import interp
 from metainterface.physics.sneddon import dlog_kc, engagement, indentation, log_kc
 
 
@@ -243,58 +243,6 @@ class _SweepFunction(torch.autograd.Function):
         return sum(g_g[1:], g_g[0]), -sum(g_x[1:], g_x[0]), None, None, None, None
 
 
-def interp(xq: Tensor, xp: Tensor, *fps: Tensor) -> Tensor | tuple[Tensor, ...]:
-    """Batched, differentiable linear interpolation, held constant beyond the ends.
-
-    xq: (B, Q) query points; xp: (B, K) non-decreasing knots; each fp: (B, K) values.
-    Returns one (B, Q) tensor per fp (a tuple if several); the knot search is shared.
-    Zero-width knot intervals (repeated xp) are safe.
-    """
-    idx, w, _, _ = interp_weights(xq, xp)
-    out = []
-    for fp in fps:
-        f0 = fp.gather(-1, idx - 1)
-        out.append(f0 + w * (fp.gather(-1, idx) - f0))
-    return out[0] if len(out) == 1 else tuple(out)
-
-
-def interp_weights(xq: Tensor, xp: Tensor) -> tuple[Tensor, Tensor, Tensor, Tensor]:
-    """The knots and weights of :func:`interp`: f(xq) = (1 - w) fp[idx - 1] + w fp[idx].
-
-    xq (B, Q), xp (B, K) -> idx (B, Q) in [1, K - 1], w (B, Q) in [0, 1] (differentiable in
-    xq and xp), the interval's width xp[idx] - xp[idx - 1] (B, Q), and the unclamped
-    ratio (xq - xp[idx - 1]) / width (B, Q; any value where the width is 0): w depends on
-    the knots only where the width is positive and the ratio in [0, 1].
-    """
-    k = xp.shape[-1]
-    idx = torch.searchsorted(xp.detach().contiguous(), xq.detach().contiguous()).clamp(1, k - 1)
-    x0, x1 = xp.gather(-1, idx - 1), xp.gather(-1, idx)
-    width = x1 - x0
-    has_width = width > 0
-    ratio = (xq - x0) / torch.where(has_width, width, 1.0)
-    return idx, torch.where(has_width, ratio.clamp(0, 1), 0.0), width, ratio
-
-
-def relative_l2(values: Tensor, reference: Tensor) -> Tensor:
-    """||values - reference||_2 / ||reference||_2 along the last axis: (B, M) -> (B,).
-
-    The relative curve error of the package, with alpha curves on the target's pressures.
-    """
-    return torch.linalg.vector_norm(values - reference, dim=-1) / torch.linalg.vector_norm(
-        reference, dim=-1
-    )
-
-
-def coverage(p_star: Tensor, p_reach: Tensor) -> Tensor:
-    """The fraction of a target's load range that a design reaches: (B, M), (B,) -> (B,).
-
-    p_star: the target's pressures (ascending, from 0 or near it); p_reach: the design's
-    largest pressure P*_max. P*_max / p_last clipped to [0, 1]: the load range is counted
-    from zero load, 1 when the design reaches the target's largest load.
-    """
-    return (p_reach / p_star[..., -1]).clamp(0.0, 1.0)
-
-
 def idle_mask(
     gamma: Tensor,
     h: Tensor,
@@ -317,30 +265,6 @@ def idle_mask(
     with torch.no_grad():
         sw = (sweep_fn or sweep)(gamma, h, settings, delta=hh.clamp(max=settings.delta_max))
     return idle | (sw.p_star >= p_limit[:, None])
-
-
-def curve_error(alpha: Tensor, reference: Tensor, p_star: Tensor, p_reach: Tensor) -> Tensor:
-    """The package's one curve error: sqrt(fit^2 + (1 - coverage)^2), (B, M) x3, (B,) -> (B,).
-
-    fit = ||alpha - alpha_t||_2 / ||alpha_t||_2 over the target's pressures p_star that the
-    design reaches (p <= p_reach, its P*_max; 0 when none with alpha_t > 0 is reached);
-    coverage = :func:`coverage`. A design that meets the whole target scores its plain
-    relative L2 error; one that stops short is charged the load range it misses, whatever
-    its curve does beyond its reach (the convention of docs/concepts/errors.md).
-    Accepts numpy arrays too (then returns numpy).
-    """
-    as_numpy = not isinstance(alpha, Tensor)
-    if as_numpy:
-        alpha, reference, p_star, p_reach = (
-            torch.as_tensor(np.asarray(v, dtype=np.float64))
-            for v in (alpha, reference, p_star, p_reach)
-        )
-    reached = p_star <= p_reach[..., None]
-    num = torch.linalg.vector_norm(torch.where(reached, alpha - reference, 0.0), dim=-1)
-    den = torch.linalg.vector_norm(torch.where(reached, reference, 0.0), dim=-1)
-    fit = torch.where(den > 0, num / torch.where(den > 0, den, 1.0), 0.0)
-    err = torch.sqrt(fit**2 + (1.0 - coverage(p_star, p_reach)) ** 2)
-    return err.numpy() if as_numpy else err
 
 
 def to_grid(sw: Sweep, n_steps: int) -> Curve:
@@ -374,164 +298,6 @@ def curve(
 ) -> Curve:
     """The alpha(P*) and S*(P*) curves of (B, N) designs on settings.n_steps pressures."""
     return to_grid(sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta), settings.n_steps)
-
-
-def alpha_at(
-    gamma: Tensor,
-    h: Tensor,
-    settings: CellSettings,
-    p_star: Tensor,
-    *,
-    smooth: float | None = None,
-    n_delta: int | None = None,
-    sweep_fn: Callable[..., Sweep] | None = None,
-    exact: bool = False,
-) -> tuple[Tensor, Tensor]:
-    """alpha of (B, N) designs at given pressures p_star (B, M), and P*_max (B,).
-
-    Beyond a design's P*_max its alpha is held at the last value (the convention of the
-    relative curve error and of the refinement's undershoot term). ``sweep_fn`` picks the
-    forward model (default: the independent one, :func:`sweep`). By default alpha is
-    interpolated linearly in a sweep of ``n_delta`` samples (settings.n_steps); ``exact``
-    solves P*(Delta) = p_star instead (:func:`at_pressures`, exact law only; ``sweep_fn``
-    must give ``load_slope`` and S*) and is exact to round-off, with exact gradients.
-    """
-    if exact:
-        if smooth is not None:
-            raise ValueError("exact alpha_at is for the exact contact law (smooth=None)")
-        sw, p_max = at_pressures(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
-        return sw.alpha, p_max
-    sw = (sweep_fn or sweep)(gamma, h, settings, smooth=smooth, n_delta=n_delta)
-    zero = torch.zeros_like(sw.p_star[:, :1])
-    p = torch.cat([zero, sw.p_star], dim=-1)
-    return interp(p_star, p, torch.cat([zero, sw.alpha], dim=-1)), p[:, -1]
-
-
-#: Newton steps at most in :func:`at_pressures`, and its tolerance on |P*(Delta) - p| / p
-#: (alpha then errs by ~1e-20 after the final step in alpha). From the interpolated start
-#: 1-3 steps reach it: P*(Delta) of independent asperities is convex, so the iterates
-#: approach the root from above after the first.
-NEWTON_STEPS, NEWTON_TOL = 8, 1e-10
-
-
-def _independent_load(gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
-    """``load(delta=...)``: P* and dP*/dDelta of the independent model of (B, N) designs at
-    per-design Deltas (B, M), nothing else.
-
-    The Newton steps of :func:`at_pressures` need only these: ~12 tensor operations a call
-    without a graph (the per-asperity constants are computed once, here), where
-    :func:`sweep` takes ~35 and keeps its products for a backward. alpha and S* are left
-    zeros and are not to be used.
-    """
-    h = anchor(h)[:, :, None]
-    floor = _contact_floor(gamma.dtype)
-    inv_g = (1.0 / gamma)[:, :, None]
-    lkc = log_kc(gamma, settings.radius)[:, :, None]
-    f_coef = (2.0 * gamma / (gamma + 1.0))[:, :, None]
-    a_nom = settings.nominal_area
-
-    def load(*, delta: Tensor, **_: object) -> Sweep:
-        d = torch.relu(delta[:, None, :] - h)  # (B, N, M)
-        a = torch.exp(inv_g * (torch.log(d.clamp_min(floor)) - lkc))
-        a = a * (d > floor)
-        p_star = (f_coef * d * a).sum(1) / a_nom
-        zeros = torch.zeros_like(p_star)
-        # dF/dd = 2 a for a power-law contact (the Sneddon force's slope)
-        return Sweep(delta, p_star, zeros, zeros, load_slope=(2.0 / a_nom) * a.sum(1))
-
-    return load
-
-
-def at_pressures(
-    gamma: Tensor,
-    h: Tensor,
-    settings: CellSettings,
-    p_star: Tensor,
-    *,
-    n_delta: int | None = None,
-    sweep_fn: Callable[..., Sweep] | None = None,
-) -> tuple[Sweep, Tensor]:
-    """The exact-law response of (B, N) designs where P*(Delta) equals p_star (B, M), and
-    P*_max (B,) (detached); Delta = Delta_max where p_star >= P*_max.
-
-    Delta is solved for without gradients (:func:`solve_delta`), then one sweep with
-    gradients at that Delta (:func:`at_delta`): P* and S* there carry gradients in gamma and
-    h at fixed Delta, and alpha is alpha(p_star) with its gradient at fixed pressure.
-    ``sweep_fn`` (default :func:`sweep`) must accept a (B, M) ``delta`` and give
-    ``load_slope``.
-    """
-    delta, p_max = solve_delta(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
-    return at_delta(gamma, h, settings, p_star, delta, p_max, sweep_fn=sweep_fn), p_max
-
-
-def solve_delta(
-    gamma: Tensor,
-    h: Tensor,
-    settings: CellSettings,
-    p_star: Tensor,
-    *,
-    n_delta: int | None = None,
-    sweep_fn: Callable[..., Sweep] | None = None,
-) -> tuple[Tensor, Tensor]:
-    """Delta (B, M) where P*(Delta) = p_star (B, M) for (B, N) designs, Delta_max where
-    p_star >= P*_max; and P*_max (B,). No gradients.
-
-    Newton steps from the linear interpolation of an ``n_delta``-sample sweep, kept inside
-    the sweep's bracket of the root (P* grows with Delta). For the default ``sweep_fn``
-    the steps evaluate only P* and its slope (:func:`_independent_load`).
-    """
-    fn = sweep_fn or sweep
-    with torch.no_grad():
-        if fn is sweep:
-            newton_fn = _independent_load(gamma, h, settings)
-        else:
-            newton_fn = functools.partial(fn, gamma, h, settings)
-        grid = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
-        coarse = newton_fn(delta=grid.expand(gamma.shape[0], -1))
-        knots = coarse.delta
-        p_max = coarse.p_star[:, -1]
-        beyond = p_star >= p_max[:, None]
-        delta = interp(p_star, coarse.p_star, knots)
-        step = float(knots[0, 1] - knots[0, 0])
-        lo, hi = (delta - step).clamp_min(0.0), (delta + step).clamp_max(settings.delta_max)
-        tol = max(NEWTON_TOL, 64 * torch.finfo(p_star.dtype).eps) * p_star.abs()
-        for _ in range(NEWTON_STEPS):
-            sw = newton_fn(delta=delta)
-            if sw.load_slope is None:
-                raise ValueError("at_pressures needs a sweep_fn that gives load_slope")
-            resid = torch.where(beyond, 0.0, sw.p_star - p_star)
-            # converged points stay put: each point's Delta, and so a design's result, does
-            # not depend on the other rows of the batch
-            done = resid.abs() <= tol
-            if bool(done.all()):
-                break
-            slope = sw.load_slope
-            move = torch.where(~done & (slope > 0), resid / torch.where(slope > 0, slope, 1.0), 0.0)
-            delta = torch.minimum(torch.maximum(delta - move, lo), hi)
-    return delta, p_max
-
-
-def at_delta(
-    gamma: Tensor,
-    h: Tensor,
-    settings: CellSettings,
-    p_star: Tensor,
-    delta: Tensor,
-    p_max: Tensor,
-    *,
-    sweep_fn: Callable[..., Sweep] | None = None,
-) -> Sweep:
-    """The response of (B, N) designs at the Deltas (B, M) that :func:`solve_delta` found
-    for p_star (B, M), with alpha moved to p_star; P*_max (B,) as it gave.
-
-    One Newton step in alpha at the converged, detached Delta: its value is alpha(p) to
-    second order in the residual, and its gradient is the implicit one, d alpha/d theta at
-    fixed p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
-    """
-    sw = (sweep_fn or sweep)(gamma, h, settings, delta=delta)
-    ok = (sw.stiffness > 0) & (p_star < p_max[:, None])
-    inv_s = torch.where(ok, 1.0 / torch.where(ok, sw.stiffness, 1.0), 0.0).detach()
-    return replace(sw, alpha=sw.alpha + (p_star - sw.p_star) * inv_s)
 
 
 def curves_numpy(

@@ -23,9 +23,9 @@ from torch import Tensor
 
 from metainterface._names import DEFAULT_MODEL
 from metainterface.errors import MetainterfaceError
-from metainterface.physics import curves
+from metainterface.physics import curves, pressures
 from metainterface.physics.cell import CellSettings, Design
-from metainterface.physics.curves import Curve, Sweep, anchor, delta_grid, interp, to_grid
+from metainterface.physics.curves import Curve, Sweep, anchor, delta_grid, to_grid
 from metainterface.physics.interaction import (
     CURVATURE,
     ITERATIONS,
@@ -33,6 +33,7 @@ from metainterface.physics.interaction import (
     load_area_interacting,
     sweep_interacting,
 )
+from metainterface.physics.metrics import interp
 from metainterface.physics.sneddon import area
 
 #: Delta samples of the dense sweep that BEM loads are interpolated on (:meth:`model_curve`).
@@ -171,7 +172,7 @@ class ForwardModel(ABC):
         last value beyond P*_max. Interpolated in an ``n_delta`` sweep, or, with ``exact``
         (exact law only), solved for P*(Delta) = p_star by Newton with exact gradients."""
         fn = self.sweep if exact else self.load_area
-        return curves.alpha_at(
+        return pressures.alpha_at(
             gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta, sweep_fn=fn, exact=exact
         )
 

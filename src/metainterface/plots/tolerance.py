@@ -17,7 +17,7 @@ def _stress_unit(values: np.ndarray) -> tuple[float, str]:
 
 
 def plot_tolerance(result) -> Figure:
-    """Panels of a :class:`~metainterface.api.tolerance.ToleranceResult`: the 5-95 % band
+    """Panels of a :class:`~metainterface.manufacture.tolerance.ToleranceResult`: the 5-95 % band
     of alpha(P*) with the nominal curve, the first-order band and the reference; the
     distribution of the relative curve error; and, with a shear strength and a modulus,
     the band of the friction law (friction stress against normal pressure)."""

@@ -10,7 +10,7 @@ from matplotlib.figure import Figure
 from metainterface.plots.common import panel_grid, percent, short, tidy_axis
 
 if TYPE_CHECKING:
-    from metainterface.validation.validate import ValidationResult
+    from metainterface.validation.result import ValidationResult
 
 
 def plot_validation(

@@ -18,9 +18,9 @@ import torch
 from matplotlib.figure import Figure
 
 from metainterface._files.atomic import write_text
-from metainterface.api.results import design_curve
 from metainterface.data import generate_dataset, load_dataset
 from metainterface.data.dataset import Dataset
+from metainterface.designer.curves import design_curve
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import METHODS, builtin_target, design
 from metainterface.physics.cell import CellSettings, Design

@@ -14,7 +14,9 @@ import numpy as np
 import torch
 
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import alpha_at, curve, relative_l2
+from metainterface.physics.curves import curve
+from metainterface.physics.metrics import relative_l2
+from metainterface.physics.pressures import alpha_at
 from metainterface.surrogate.data import Split
 from metainterface.surrogate.loss import PAPER_WEIGHTS, LossWeights
 from metainterface.surrogate.model import InverseMLP

@@ -16,7 +16,8 @@ import torch
 from torch import Tensor
 
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import Curve, relative_l2
+from metainterface.physics.curves import Curve
+from metainterface.physics.metrics import relative_l2
 
 
 @dataclass(frozen=True)

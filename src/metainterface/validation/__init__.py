@@ -30,12 +30,11 @@ from metainterface.validation.heightmap import (
     height_map,
     owner_map,
 )
+from metainterface.validation.result import ValidationResult, design_target
 from metainterface.validation.validate import (
     DEFAULT_LOADS,
     ValidationPlan,
-    ValidationResult,
     check_jobs,
-    design_target,
     plan_validation,
     resolve_loads,
     validate_design,

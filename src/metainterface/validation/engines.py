@@ -18,7 +18,7 @@ import numpy as np
 
 from metainterface._names import DEFAULT_ENGINE
 from metainterface.errors import MetainterfaceError
-from metainterface.validation.bem import (
+from metainterface.validation.loadpath import (
     MAX_ITER,
     TOLERANCE,
     LoadPath,

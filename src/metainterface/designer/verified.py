@@ -8,7 +8,7 @@ from dataclasses import replace
 import torch
 from torch import Tensor
 
-from metainterface.api.results import DesignResult
+from metainterface.designer.results import DesignResult
 from metainterface.inverse.params import DTYPE, FixedHeights, Parameterisation
 from metainterface.inverse.pipeline import METHODS
 from metainterface.inverse.refine import RefineSettings

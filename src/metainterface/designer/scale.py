@@ -227,7 +227,7 @@ def design_scale(
     tiling it gives (cells and cells per side), the candidates and their scores and the
     feasibility summary, and design.json records them.
     """
-    from metainterface.api.functions import design
+    from metainterface.designer.run import design
     from metainterface.physical.friction import FrictionLaw, friction_target
 
     source = str(law) if not isinstance(law, FrictionLaw) else law.source

@@ -10,7 +10,8 @@ import numpy as np
 
 from metainterface._files import strict_json
 from metainterface._files.atomic import write_text
-from metainterface.api.results import DesignResult, design_curve
+from metainterface.designer.curves import design_curve
+from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import MODELS, get_model

@@ -1,0 +1,163 @@
+"""Option groups of :func:`~metainterface.design`: small frozen values a user builds once and
+passes to every design (``mi.design(t, scale=..., robust=..., effort=...)``).
+
+Each group stands for keywords :func:`~metainterface.design` also takes one by one (the
+command line's options map to those); a group and one of its own keywords in the same call
+is refused, so that no value silently wins. The values are checked where they are used, with
+the same one-line errors as the keywords.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+from metainterface.errors import MetainterfaceError
+from metainterface.inverse.refine import RefineSettings
+
+
+@dataclass(frozen=True)
+class Scale:
+    """The user's scale: the size, the material pair and what the patch carries, in SI.
+
+    With a scale, a design's ``design.json`` holds its dimensions in SI (the physical block),
+    a stress ``max_pressure`` ('50MPa') is read against the modulus, and lengths given to
+    ``z_step`` or :class:`Robust`'s ``sigma_h`` ('1um') are read in units of R.
+
+    Attributes
+    ----------
+    radius : str or float or None
+        R, the asperity's lateral size ('0.5mm', or m); with ``modulus`` it adds the
+        design's dimensions in SI to design.json.
+    modulus : str or float or None
+        E* of the material pair ('2MPa', or Pa).
+    total_force : str or float or None
+        A total normal force the patch carries ('10N'): design.json then gives the number of
+        cells for it. Needs ``radius`` and ``modulus``; not with ``area``.
+    area : str or float or None
+        The patch's area ('4cm2', or m^2), instead of ``total_force``.
+
+    Examples
+    --------
+    >>> import metainterface as mi
+    >>> pad = mi.Scale(radius="0.5mm", modulus="2MPa", area="4cm2")
+    >>> pad.radius
+    '0.5mm'
+    """
+
+    radius: str | float | None = None
+    modulus: str | float | None = None
+    total_force: str | float | None = None
+    area: str | float | None = None
+
+
+@dataclass(frozen=True)
+class Robust:
+    """A robust design: made for a printer's errors rather than for the nominal cell.
+
+    Each start is refined against the mean squared error of ``samples`` perturbed copies of
+    it (the same draws for every start, in the same batch); the start with the smallest rms
+    error over them wins. ``result.error`` stays the nominal design's; ``result.robust``
+    holds the nominal and robust statistics (those of 1024 made cells drawn independently).
+    Passing ``robust=Robust(...)`` to :func:`~metainterface.design` is ``robust=True`` with
+    these errors.
+
+    Attributes
+    ----------
+    sigma_h : float or str
+        Standard deviation of each asperity's height error: a plain number in units of R, or
+        a length ('1um') with :class:`Scale`'s ``radius``; >= 0.
+    sigma_gamma : float
+        Standard deviation of each shape exponent's error (absolute); >= 0.
+    scale_sigma : float
+        Standard deviation of a common relative scale of the relief, in [0, 0.5].
+    samples : int
+        K, perturbed copies per start, in [1, 1024]; the cost grows about K-fold.
+
+    At least one sigma must be > 0 (checked by :func:`~metainterface.design`).
+
+    Examples
+    --------
+    >>> import metainterface as mi
+    >>> printer = mi.Robust(sigma_h=0.002, sigma_gamma=0.05, samples=8)
+    >>> printer.samples
+    8
+    """
+
+    sigma_h: float | str = 0.0
+    sigma_gamma: float = 0.0
+    scale_sigma: float = 0.0
+    samples: int = 16
+
+
+@dataclass(frozen=True)
+class Effort:
+    """How hard a design searches: its starts, the surrogate's hedge and fallback, the
+    refinement and the seed.
+
+    Attributes
+    ----------
+    starts : int
+        Random starts of the multistart and Hertz methods, in [1, 10000].
+    hedge : int
+        Surrogate method: extra starts refined beside the prediction (half jittered copies of
+        it, half random), in [0, 10000]; 0 is the paper's pure pipeline.
+    fallback : int
+        Surrogate method: a target still missed by more than 2 % also gets a multistart with
+        this many starts, the better design kept; 0 turns it off.
+    refine : bool
+        Refine the starts (False: the zero-shot prediction or the best raw start).
+    seed : int
+        Seed of every random draw, in [0, 2**63 - 1]; the same seed gives the same designs.
+    refine_settings : RefineSettings or None
+        The refinement's stages, iterations and tolerances (default: the paper's 5 stages x
+        5 steps x 20 iterations, then the polish); fewer make a quicker, rougher design.
+
+    Examples
+    --------
+    >>> import metainterface as mi
+    >>> quick = mi.Effort(starts=8, hedge=2, fallback=0, seed=1)
+    >>> quick.starts, quick.refine
+    (8, True)
+    """
+
+    starts: int = 50
+    hedge: int = 8
+    fallback: int = 50
+    refine: bool = True
+    seed: int = 0
+    refine_settings: RefineSettings | None = None
+
+
+#: The keyword of :func:`~metainterface.design` that each group's field stands for (where
+#: the two names differ).
+KEYWORDS: dict[type, dict[str, str]] = {Robust: {"samples": "robust_samples"}}
+
+
+def merge(group: Any, kind: type, argument: str, given: dict[str, Any]) -> dict[str, Any]:
+    """The keywords of ``kind``'s fields: from ``group`` (an instance or None), else from the
+    keywords ``given`` (None where not given), else the group's defaults.
+
+    Raises MetainterfaceError naming ``argument`` when ``group`` is of another type, or
+    when it comes with one of its own keywords.
+    """
+    rename = KEYWORDS.get(kind, {})
+    names = {f.name: rename.get(f.name, f.name) for f in fields(kind)}
+    if group is None:
+        group = kind()
+    else:
+        if not isinstance(group, kind):
+            raise MetainterfaceError(
+                f"{argument} must be {kind.__name__}(...), got {type(group).__name__}",
+                argument=argument,
+            )
+        both = [kw for kw in names.values() if given.get(kw) is not None]
+        if both:
+            raise MetainterfaceError(
+                f"give {argument}={kind.__name__}(...) or {', '.join(both)}, not both",
+                argument=argument,
+            )
+    return {
+        kw: getattr(group, name) if given.get(kw) is None else given[kw]
+        for name, kw in names.items()
+    }

@@ -1,0 +1,434 @@
+"""Designing: :func:`design` (a target to a checked design) and :func:`compare` (all three
+methods). numpy and lists in, numpy out; every argument checked with a one-line
+MetainterfaceError."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from metainterface import _checks
+from metainterface._device import resolve_device
+from metainterface._files import check_output_folder, output_set
+from metainterface.designer.curves import reach_note
+from metainterface.designer.given import _limit, _physical_options
+from metainterface.designer.options import Effort, Robust, Scale, merge
+from metainterface.designer.results import DesignResult
+from metainterface.designer.robust import _manufacturing, _printable_record, _robust_stats
+from metainterface.errors import MetainterfaceError
+from metainterface.inverse import pipeline
+from metainterface.inverse.perturb import Perturbation
+from metainterface.inverse.reach import refuse_unreachable
+from metainterface.inverse.refine import RefineSettings
+from metainterface.inverse.targets import Target
+from metainterface.physical.dimensions import physical_block
+from metainterface.physical.units import (
+    parse_pressure,
+)
+from metainterface.physics.cell import CellSettings, Design
+from metainterface.physics.limits import PressureCheck, check_pressure, pressure_penalty
+from metainterface.physics.models import ForwardModel, get_model
+from metainterface.verify.check import Verify, as_verify
+
+#: Upper bounds that keep a request within this machine's memory and a sane run time.
+MAX_STARTS = 10_000
+MAX_SEED = _checks.MAX_SEED
+
+
+#: Memory of one start per asperity during refinement (about twice what the multistart
+#: uses, so that a refusal is never wrong).
+BYTES_PER_START = 16 * 2**10
+#: Weight of the pressure-limit penalty added to the refinement's loss.
+PRESSURE_WEIGHT = 10.0
+
+
+def _targets(targets: Target | str | Sequence[Target | str]) -> tuple[list[Target], bool]:
+    """The targets as a list, and whether one was given alone (then one result back)."""
+    single = isinstance(targets, Target | str)
+    items = [targets] if single else list(targets)  # type: ignore[arg-type]
+    if not items:
+        raise MetainterfaceError("targets: give at least one target")
+    out = []
+    for t in items:
+        if isinstance(t, str):
+            t = Target.builtin(t)
+        if not isinstance(t, Target):
+            raise MetainterfaceError(
+                f"targets must be Target objects or built-in names ({', '.join(Target.builtins())})"
+                f", got {type(t).__name__}"
+            )
+        out.append(t)
+    names = [t.name for t in out]
+    if len(set(names)) != len(names):
+        raise MetainterfaceError(f"target names must be distinct, got {', '.join(names)}")
+    return out, single
+
+
+def design(
+    targets: Target | str | Sequence[Target | str],
+    *,
+    method: str = "surrogate",
+    model: str | ForwardModel | None = None,
+    settings: CellSettings | None = None,
+    surrogate: str | os.PathLike[str] | None = None,
+    effort: Effort | None = None,
+    scale: Scale | None = None,
+    robust: bool | Robust = False,
+    max_pressure: float | str | None = None,
+    z_step: float | str | None = None,
+    verify: bool | Verify = True,
+    force: bool = False,
+    device: str = "auto",
+    out: str | os.PathLike[str] | None = None,
+    full_target: bool = False,
+    meta: dict[str, Any] | None = None,
+    starts: int | None = None,
+    hedge: int | None = None,
+    fallback: int | None = None,
+    refine: bool | None = None,
+    seed: int | None = None,
+    refine_settings: RefineSettings | None = None,
+    radius: str | float | None = None,
+    modulus: str | float | None = None,
+    total_force: str | float | None = None,
+    area: str | float | None = None,
+    sigma_h: float | str | None = None,
+    sigma_gamma: float | None = None,
+    scale_sigma: float | None = None,
+    robust_samples: int | None = None,
+) -> DesignResult | list[DesignResult]:
+    """Design a unit cell whose alpha(P*) follows each target, checked in BEM.
+
+    ``mi.design(t)`` is enough; the options come in groups (built once, reused)::
+
+        mi.design(t, effort=mi.Effort(starts=8, seed=1),
+                  scale=mi.Scale(radius="0.5mm", modulus="2MPa", area="4cm2"),
+                  robust=mi.Robust(sigma_h="1um", samples=8), z_step="10um")
+
+    Parameters
+    ----------
+    targets : Target, str or list of them
+        A target, a built-in name (``"bilinear"``, ...), or a list (designed in one batch;
+        a list of results back).
+    method : {"surrogate", "multistart", "hertz"}
+        The surrogate's prediction then refinement (default), random starts refined, or the
+        Hertz-only baseline (gamma = 2).
+    model : str or ForwardModel
+        Forward model: ``"independent"`` (default), ``"interacting"`` or an instance.
+    settings : CellSettings
+        The design space (N, gamma bounds, Delta_max); the default is the paper's cell.
+    surrogate : path
+        A surrogate model file (``metainterface train``), default the shipped one.
+    effort : Effort
+        Starts, hedge, fallback, refine, seed and refine_settings (see :class:`Effort`).
+    scale : Scale
+        Radius, modulus, total_force or area in SI (see :class:`Scale`).
+    robust : bool or Robust
+        Design for a printer's errors (see :class:`Robust`).
+    max_pressure : float or str
+        A peak pressure limit: p/E* in (0, 1], or a stress ('50MPa') with a modulus.
+    z_step : float or str
+        A printer's layer height (units of R, or '1um' with a radius): the heights are
+        snapped to it and the gammas re-refined; ``result.printable`` reports the errors.
+    verify : bool or Verify
+        Check (and correct) each design in BEM (default ``Verify()``); False skips it.
+    force : bool
+        Design a friction law no cell can follow anyway (the closest cell, ``result.forced``);
+        without it such a target raises :class:`~metainterface.UnreachableError`.
+    device : str
+        ``"auto"`` (CUDA when torch sees it), ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
+    out : path
+        Write each result's files here (several targets: ``out/<name>``).
+    full_target, meta
+        With ``out``: also the whole target in target.csv; extra keys for design.json.
+    starts, hedge, fallback, refine, seed, refine_settings
+        One by one, the fields of ``effort``.
+    radius, modulus, total_force, area
+        One by one, the fields of ``scale``.
+    sigma_h, sigma_gamma, scale_sigma, robust_samples
+        One by one, the fields of a ``Robust`` (``robust_samples`` is its ``samples``),
+        with ``robust=True``.
+
+    Returns
+    -------
+    DesignResult or list of DesignResult
+        One per target, in order.
+    """
+    knobs = merge(
+        effort,
+        Effort,
+        "effort",
+        {
+            "starts": starts,
+            "hedge": hedge,
+            "fallback": fallback,
+            "refine": refine,
+            "seed": seed,
+            "refine_settings": refine_settings,
+        },
+    )
+    starts, hedge, fallback, refine, seed = (
+        knobs["starts"],
+        knobs["hedge"],
+        knobs["fallback"],
+        knobs["refine"],
+        knobs["seed"],
+    )
+    refine_settings = knobs["refine_settings"]
+    size = merge(
+        scale,
+        Scale,
+        "scale",
+        {"radius": radius, "modulus": modulus, "total_force": total_force, "area": area},
+    )
+    radius, modulus, total_force, area = (
+        size["radius"],
+        size["modulus"],
+        size["total_force"],
+        size["area"],
+    )
+    errors = merge(
+        robust if isinstance(robust, Robust) else None,
+        Robust,
+        "robust",
+        {
+            "sigma_h": sigma_h,
+            "sigma_gamma": sigma_gamma,
+            "scale_sigma": scale_sigma,
+            "robust_samples": robust_samples,
+        },
+    )
+    robust = True if isinstance(robust, Robust) else robust
+    items, single = _targets(targets)
+    if not isinstance(force, bool):
+        raise MetainterfaceError(f"force must be True or False, got {force!r}")
+    if settings is not None and not isinstance(settings, CellSettings):
+        raise MetainterfaceError("settings must be a CellSettings")
+    reach = refuse_unreachable(items, settings, force)  # before any work or file
+    if out is not None:  # before any work: a bad folder should not cost a design run
+        check_output_folder(out)
+    _checks.choice("method", method, pipeline.METHODS)
+    starts = _checks.whole("starts", starts, low=1, high=MAX_STARTS)
+    hedge = _checks.whole("hedge", hedge, low=0, high=MAX_STARTS)
+    fallback = _checks.whole("fallback", fallback, low=0, high=MAX_STARTS)
+    seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
+    n = (settings or CellSettings()).n_asperities
+    dev = resolve_device(device)
+    affordable_rows(method, starts, hedge, fallback, len(items), n, dev)
+    if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
+        raise MetainterfaceError("refine_settings must be a RefineSettings")
+    if not isinstance(refine, bool):
+        raise MetainterfaceError(f"refine must be True or False, got {refine!r}")
+    if not isinstance(full_target, bool):
+        raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
+    fm = get_model(model)
+    checks = as_verify(verify, device)
+    if checks is not None:  # a bad grid or device fails now, not after the design
+        checks.ready(settings or CellSettings())
+    limit = _limit(max_pressure, modulus)
+    extra_loss = None
+    if limit is not None:
+
+        def extra_loss(gamma, h, cell, limit=limit):
+            return PRESSURE_WEIGHT * pressure_penalty(gamma, h, cell, limit)
+
+    physical = _physical_options(radius, modulus, total_force, area)
+    perturb, step, radius_m = _manufacturing(
+        robust,
+        errors["sigma_h"],
+        errors["sigma_gamma"],
+        errors["scale_sigma"],
+        errors["robust_samples"],
+        z_step,
+        radius,
+        settings,
+        seed,
+    )
+    raw = pipeline.design(
+        items,
+        method,
+        refine_designs=refine,
+        settings=settings,
+        model_path=surrogate,
+        starts=starts,
+        seed=seed,
+        extra_loss=extra_loss,
+        model=fm,
+        refine_settings=refine_settings,
+        hedge=hedge if method == "surrogate" else 0,
+        fallback=fallback if method == "surrogate" else 0,
+        perturb=perturb,
+        z_step=step,
+        device=dev,
+    )
+    results = [_public(r, limit, modulus) for r in raw]
+    results = [_forced(r, reach.get(r.target.name)) for r in results]
+    if perturb is not None:
+        results = [_robust_stats(r, perturb, seed, dev) for r in results]
+    if step is not None:
+        results = [_printable_record(r, radius_m) for r in results]
+    if checks is not None:
+        results = _verify_all(
+            results, checks, extra_loss, refine_settings, step, perturb, limit, modulus
+        )
+    if out is not None:
+        out = Path(out)
+        folders = [out] if single else [out / r.target.name for r in results]
+        _save_all(results, folders, physical, meta, full_target)
+    return results[0] if single else results
+
+
+def affordable_rows(
+    method: str, starts: int, hedge: int, fallback: int, targets: int, n: int, device: Any
+) -> None:
+    """Refuse a design whose largest batch would not fit in memory (the GPU's on CUDA).
+
+    The rows refined together: ``starts`` per target by multistart and Hertz; by the
+    surrogate, 1 + ``hedge`` per target, then ``fallback`` per target for the targets it
+    missed, in a batch of its own after the first is freed (so the larger of the two, not
+    their sum)."""
+    per_target = starts if method != "surrogate" else max(1 + hedge, fallback)
+    nbytes = per_target * targets * n * BYTES_PER_START
+    what = f" for {targets} targets" if targets > 1 else ""
+    if device.type != "cuda":
+        _checks.affordable("starts", starts, nbytes, what=what)
+        return
+    import torch
+
+    total = torch.cuda.get_device_properties(device).total_memory
+    if nbytes > _checks.MEMORY_SHARE * total:
+        raise MetainterfaceError(
+            f"starts = {starts} would need about {nbytes / 2**30:.1f} GiB on {device}{what}, "
+            f"more than half its {total / 2**30:.1f} GiB; design fewer targets per call",
+            argument="starts",
+        )
+
+
+def _verify_all(
+    results: list[DesignResult],
+    checks: Verify,
+    extra_loss: Any,
+    refine_settings: RefineSettings | None,
+    step: float | None,
+    perturb: Perturbation | None,
+    limit: float | None,
+    modulus: Any,
+) -> list[DesignResult]:
+    """Each result checked (and where asked, corrected) in BEM; a corrected design gets its
+    pressure check again."""
+    from metainterface.designer.verified import verified
+
+    out = []
+    for r in results:
+        v = verified(
+            r,
+            checks,
+            extra_loss=extra_loss,
+            refine_settings=refine_settings,
+            z_step=step,
+            robust=perturb is not None,
+        )
+        if v.design is not r.design and r.pressure is not None:
+            v = replace(v, pressure=_pressure(v.design, limit, modulus))
+        out.append(v)
+    return out
+
+
+def _pressure(d: Design, limit: float | None, modulus: Any) -> PressureCheck | None:
+    if limit is None:
+        return None
+    e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
+    return check_pressure(d, limit if e_star is None else limit * e_star, e_star=e_star)
+
+
+def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> DesignResult:
+    d = Design(gamma=r.gamma, h=r.h, settings=r.settings)
+    notes = (*r.notes, *pipeline.reachability_warnings(r.target, r.settings))
+    pressure = _pressure(d, limit, modulus)
+    out = DesignResult(
+        target=r.target,
+        design=d,
+        error=r.error,
+        initial_error=r.initial_error,
+        method=r.method,
+        seconds=r.seconds,
+        model=r.model,
+        start=r.start,
+        fallback=r.fallback,
+        notes=notes,
+        pressure=pressure,
+        printable=r.quantisation,
+        robust_error_refined=r.robust_error,
+    )
+    more = reach_note(out.coverage, out.idle, d.n_asperities)
+    return replace(out, notes=(*notes, *more)) if more else out
+
+
+def _forced(r: DesignResult, reach: Any) -> DesignResult:
+    """The result marked as forced when its friction law is out of reach."""
+    if reach is None or reach.reachable:
+        return r
+    note = "FORCED: the friction law is out of reach, this is the closest cell; " + (
+        reach.message.replace("\n", " ")
+    )
+    return replace(r, forced=True, notes=(note, *r.notes))
+
+
+def _save_all(
+    results: list[DesignResult],
+    folders: list[Path],
+    physical: dict | None,
+    meta: dict[str, Any] | None,
+    full_target: bool = False,
+) -> None:
+    with output_set():  # every result's files, or none
+        for r, folder in zip(results, folders, strict=True):
+            extra = {"command": meta} if meta else {}
+            if physical is not None:
+                extra["physical"] = physical_block(r.design, **physical)
+            r.save(folder, full_target=full_target, **extra)
+
+
+def compare(
+    targets: Target | str | Sequence[Target | str],
+    *,
+    out: str | os.PathLike[str] | None = None,
+    **options: Any,
+) -> dict[str, list[DesignResult]]:
+    """Design every target with all three methods (paper fig. 5): {method: [results]}.
+
+    ``options`` are those of :func:`design`; with ``out``, each method's files go to
+    ``out/<target>/<method>/`` and the comparison figure to ``out/<target>/compare.png``
+    (one target: ``out/<method>/`` and ``out/compare.png``).
+    """
+    items, single = _targets(targets)
+    if out is not None:
+        check_output_folder(out)
+    if "method" in options:
+        raise MetainterfaceError("compare runs every method; leave method out")
+    meta = options.pop("meta", None)
+    full_target = options.pop("full_target", False)
+    given = {k: options.pop(k, None) for k in ("radius", "modulus", "total_force", "area")}
+    size = merge(options.pop("scale", None), Scale, "scale", given)
+    physical = _physical_options(size["radius"], size["modulus"], size["total_force"], size["area"])
+    if size["modulus"] is not None:  # the designs read a stress max_pressure against it
+        options["modulus"] = size["modulus"]
+    by_method = {
+        m: design(items, method=m, **options)  # type: ignore[misc]
+        for m in pipeline.METHODS
+    }
+    if out is not None:
+        from metainterface.plots import plot_comparison, save_figure
+
+        out = Path(out)
+        with output_set():  # all methods' files and figures, or none
+            for i, t in enumerate(items):
+                per = [by_method[m][i] for m in pipeline.METHODS]
+                base = out if single else out / t.name
+                _save_all(per, [base / r.method for r in per], physical, meta, full_target)
+                fig = plot_comparison([per], [[r.curve() for r in per]])
+                save_figure(fig, base / "compare.png", command="compare")
+    return by_method  # type: ignore[return-value]

@@ -1,0 +1,174 @@
+"""Where the refinement starts: random cells, the hedge beside the surrogate's prediction, and
+the prediction itself (with views of a target that ends without stiffness)."""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from metainterface.inverse.params import (
+    DTYPE,
+    FULL,
+    Parameterisation,
+)
+from metainterface.inverse.refine import (
+    TargetGrid,
+    relative_error,
+)
+from metainterface.inverse.targets import Target, target_features
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.models import ForwardModel
+
+if TYPE_CHECKING:  # the surrogate (and its imports) load only when a design needs it
+    from metainterface.surrogate.model import InverseMLP
+
+
+def random_starts(
+    count: int, n_targets: int, settings: CellSettings, seed: int, param: Parameterisation
+) -> tuple[Tensor, Tensor]:
+    """``count`` random starts (gamma, h), each (n_targets * count, N), the same for every
+    target: a target's design does not depend on the others in the batch."""
+    gamma, h = param.random(count, settings, torch.Generator().manual_seed(seed))
+    return gamma.repeat(n_targets, 1), h.repeat(n_targets, 1)
+
+
+#: Spread of the jittered copies of the zero-shot design among the hedge starts: normal,
+#: with these standard deviations in units of the gamma range and of Delta_max.
+JITTER_GAMMA, JITTER_H = 0.1, 0.05
+
+
+def hedge_starts(
+    gamma0: Tensor, h0: Tensor, hedge: int, settings: CellSettings, seed: int
+) -> tuple[Tensor, Tensor]:
+    """(T, hedge, N) extra starts beside the zero-shot designs gamma0, h0 (T, N).
+
+    The first half are jittered copies of the zero-shot design: the refinement of a
+    near-miss often ends in a neighbouring basin that is better.
+    The rest are the random starts of the multistart baseline (its first ones), for targets
+    the surrogate reads wrong (the linear law). Seeded; the same for every target."""
+    t, n = gamma0.shape
+    jittered = (hedge + 1) // 2
+    g_r, h_r = random_starts(hedge - jittered, t, settings, seed, FULL)
+    gen = torch.Generator().manual_seed(seed + 1)
+    z = torch.randn((jittered, 2 * n), generator=gen, dtype=gamma0.dtype)
+    span = settings.gamma_max - settings.gamma_min
+    g_j = (gamma0[:, None] + JITTER_GAMMA * span * z[:, :n]).clamp(
+        settings.gamma_min, settings.gamma_max
+    )
+    h_j = (h0[:, None] + JITTER_H * settings.delta_max * z[:, n:]).clamp_min(0.0)
+    return (
+        torch.cat([g_j, g_r.view(t, -1, n)], 1),
+        torch.cat([h_j, h_r.view(t, -1, n)], 1),
+    )
+
+
+def predict(
+    model: InverseMLP, targets: Sequence[Target], settings: CellSettings
+) -> tuple[Tensor, Tensor]:
+    """Zero-shot designs (T, N) for the targets from the surrogate.
+
+    One target at a time, in float64. Matrix products round differently with the batch size
+    (by ~1e-16 in float64), and the refinement's stopping decisions can carry even that into
+    another local optimum. Row by row, a target gets the same design alone or in any batch,
+    and the network is cheap next to the refinement."""
+    net = copy.deepcopy(model).to(DTYPE).eval()
+    with torch.no_grad():
+        rows = [
+            net.design(conform(net, target_features(t, settings.n_steps)), settings)
+            for t in targets
+        ]
+    return torch.cat([g for g, _ in rows]), torch.cat([h for _, h in rows])
+
+
+#: Views of a target without stiffness that the surrogate also reads: its end extended by
+#: these factors of P*_max (the tail's power law continued) and cut at these fractions.
+#: The network was trained on curves that end at Delta_max; a measured law ends wherever
+#: the measurement stopped, and a design that follows it may reach Delta_max later or
+#: sooner. Each view's prediction is measured on the target itself and the best kept.
+#: 24 end factors log-spaced over [0.15, 12] (benchmarks/bench_friction_laws.py: 12 gave
+#: a median zero-shot error a tenth higher, 40 a tenth lower at twice the views).
+_ENDS = np.geomspace(0.15, 12.0, 24)
+
+
+EXTEND_VIEWS = tuple(float(f) for f in _ENDS if f > 1.05)
+
+
+CUT_VIEWS = tuple(float(f) for f in _ENDS if f < 0.95)
+
+
+#: The share of the pressure range whose log-log slope continues the tail.
+TAIL_SHARE = 0.25
+
+
+def target_views(target: Target) -> list[Target]:
+    """The extended and cut views of a target (see EXTEND_VIEWS), without stiffness."""
+    p, a = target.p_star, target.alpha
+    p_max, a_max = float(p[-1]), float(a[-1])
+    tail = (p >= (1 - TAIL_SHARE) * p_max) & (p > 0) & (a > 0)
+    slope = 1.0
+    if tail.sum() >= 2 and np.ptp(np.log(p[tail])) > 0:
+        slope = float(np.polyfit(np.log(p[tail]), np.log(a[tail]), 1)[0])
+    slope = float(np.clip(slope, 0.2, 1.5))  # a contact curve's tail: sub- to mildly super-linear
+    views = []
+    for k in EXTEND_VIEWS:
+        extra = p_max * np.linspace(1.0, k, 17)[1:]
+        ext_a = np.minimum(a_max * (extra / p_max) ** slope, 0.99)
+        views.append(
+            Target(np.concatenate([p, extra]), np.concatenate([a, ext_a]), name=target.name)
+        )
+    for f in CUT_VIEWS:
+        keep = p <= f * p_max
+        if keep.sum() >= 3 and a[keep][-1] > 0:
+            views.append(Target(p[keep], a[keep], name=target.name))
+    return views
+
+
+def best_views(
+    net: InverseMLP,
+    targets: Sequence[Target],
+    gamma0: Tensor,
+    h0: Tensor,
+    settings: CellSettings,
+    model: ForwardModel,
+    points: int,
+) -> tuple[Tensor, Tensor]:
+    """The zero-shot designs (T, N), each target without stiffness given the best of its
+    own prediction and those of its views (:func:`target_views`), by the error on the
+    target itself."""
+    gamma0, h0 = gamma0.clone(), h0.clone()
+    for i, t in enumerate(targets):
+        if t.stiffness is not None:
+            continue
+        views = target_views(t)
+        if not views:
+            continue
+        g_v, h_v = predict(net, views, settings)
+        g = torch.cat([gamma0[i : i + 1], g_v])
+        h = torch.cat([h0[i : i + 1], h_v])
+        grid = TargetGrid.from_curves([(t.p_star, t.alpha)], points)
+        err = relative_error(
+            g, h, settings, grid.rows(torch.zeros(g.shape[0], dtype=torch.long)), model
+        )
+        k = int(err.argmin())
+        gamma0[i], h0[i] = g[k], h[k]
+    return gamma0, h0
+
+
+#: Training-set spread below which an input counts as constant (alpha_hat at both ends,
+#: S_hat at P* = 0).
+CONSTANT_STD = 1e-4
+
+
+def conform(net: InverseMLP, features: Tensor) -> Tensor:
+    """Features (F,) as a (1, F) float64 batch, with the inputs that were constant in the
+    network's training set set to that constant. The standardisation divides them by a
+    spread of ~1e-6: a target that differs there by round-off or an estimate (S* at P* = 0
+    by finite differences) would push the first layer 1e5 standard deviations away."""
+    x = features.to(DTYPE)[None]
+    fixed = net.in_std.to(DTYPE) < CONSTANT_STD
+    return torch.where(fixed, net.in_mean.to(DTYPE), x)

@@ -1,0 +1,173 @@
+"""A design at given pressures: alpha at a target's P* (the Delta sweep interpolated), and the
+indentation Delta that makes each pressure (solved on the sweep, exact at the grid points)."""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from dataclasses import replace
+
+import torch
+from torch import Tensor
+
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.curves import Sweep, _contact_floor, anchor, delta_grid, sweep
+from metainterface.physics.metrics import interp
+from metainterface.physics.sneddon import log_kc
+
+#: Newton steps at most in :func:`at_pressures`, and its tolerance on |P*(Delta) - p| / p
+#: (alpha then errs by ~1e-20 after the final step in alpha). From the interpolated start
+#: 1-3 steps reach it: P*(Delta) of independent asperities is convex, so the iterates
+#: approach the root from above after the first.
+NEWTON_STEPS, NEWTON_TOL = 8, 1e-10
+
+
+def alpha_at(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_star: Tensor,
+    *,
+    smooth: float | None = None,
+    n_delta: int | None = None,
+    sweep_fn: Callable[..., Sweep] | None = None,
+    exact: bool = False,
+) -> tuple[Tensor, Tensor]:
+    """alpha of (B, N) designs at given pressures p_star (B, M), and P*_max (B,).
+
+    Beyond a design's P*_max its alpha is held at the last value (the convention of the
+    relative curve error and of the refinement's undershoot term). ``sweep_fn`` picks the
+    forward model (default: the independent one, :func:`sweep`). By default alpha is
+    interpolated linearly in a sweep of ``n_delta`` samples (settings.n_steps); ``exact``
+    solves P*(Delta) = p_star instead (:func:`at_pressures`, exact law only; ``sweep_fn``
+    must give ``load_slope`` and S*) and is exact to round-off, with exact gradients.
+    """
+    if exact:
+        if smooth is not None:
+            raise ValueError("exact alpha_at is for the exact contact law (smooth=None)")
+        sw, p_max = at_pressures(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
+        return sw.alpha, p_max
+    sw = (sweep_fn or sweep)(gamma, h, settings, smooth=smooth, n_delta=n_delta)
+    zero = torch.zeros_like(sw.p_star[:, :1])
+    p = torch.cat([zero, sw.p_star], dim=-1)
+    return interp(p_star, p, torch.cat([zero, sw.alpha], dim=-1)), p[:, -1]
+
+
+def _independent_load(gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
+    """``load(delta=...)``: P* and dP*/dDelta of the independent model of (B, N) designs at
+    per-design Deltas (B, M), nothing else.
+
+    The Newton steps of :func:`at_pressures` need only these: ~12 tensor operations a call
+    without a graph (the per-asperity constants are computed once, here), where
+    :func:`sweep` takes ~35 and keeps its products for a backward. alpha and S* are left
+    zeros and are not to be used.
+    """
+    h = anchor(h)[:, :, None]
+    floor = _contact_floor(gamma.dtype)
+    inv_g = (1.0 / gamma)[:, :, None]
+    lkc = log_kc(gamma, settings.radius)[:, :, None]
+    f_coef = (2.0 * gamma / (gamma + 1.0))[:, :, None]
+    a_nom = settings.nominal_area
+
+    def load(*, delta: Tensor, **_: object) -> Sweep:
+        d = torch.relu(delta[:, None, :] - h)  # (B, N, M)
+        a = torch.exp(inv_g * (torch.log(d.clamp_min(floor)) - lkc))
+        a = a * (d > floor)
+        p_star = (f_coef * d * a).sum(1) / a_nom
+        zeros = torch.zeros_like(p_star)
+        # dF/dd = 2 a for a power-law contact (the Sneddon force's slope)
+        return Sweep(delta, p_star, zeros, zeros, load_slope=(2.0 / a_nom) * a.sum(1))
+
+    return load
+
+
+def at_pressures(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_star: Tensor,
+    *,
+    n_delta: int | None = None,
+    sweep_fn: Callable[..., Sweep] | None = None,
+) -> tuple[Sweep, Tensor]:
+    """The exact-law response of (B, N) designs where P*(Delta) equals p_star (B, M), and
+    P*_max (B,) (detached); Delta = Delta_max where p_star >= P*_max.
+
+    Delta is solved for without gradients (:func:`solve_delta`), then one sweep with
+    gradients at that Delta (:func:`at_delta`): P* and S* there carry gradients in gamma and
+    h at fixed Delta, and alpha is alpha(p_star) with its gradient at fixed pressure.
+    ``sweep_fn`` (default :func:`sweep`) must accept a (B, M) ``delta`` and give
+    ``load_slope``.
+    """
+    delta, p_max = solve_delta(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
+    return at_delta(gamma, h, settings, p_star, delta, p_max, sweep_fn=sweep_fn), p_max
+
+
+def solve_delta(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_star: Tensor,
+    *,
+    n_delta: int | None = None,
+    sweep_fn: Callable[..., Sweep] | None = None,
+) -> tuple[Tensor, Tensor]:
+    """Delta (B, M) where P*(Delta) = p_star (B, M) for (B, N) designs, Delta_max where
+    p_star >= P*_max; and P*_max (B,). No gradients.
+
+    Newton steps from the linear interpolation of an ``n_delta``-sample sweep, kept inside
+    the sweep's bracket of the root (P* grows with Delta). For the default ``sweep_fn``
+    the steps evaluate only P* and its slope (:func:`_independent_load`).
+    """
+    fn = sweep_fn or sweep
+    with torch.no_grad():
+        if fn is sweep:
+            newton_fn = _independent_load(gamma, h, settings)
+        else:
+            newton_fn = functools.partial(fn, gamma, h, settings)
+        grid = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
+        coarse = newton_fn(delta=grid.expand(gamma.shape[0], -1))
+        knots = coarse.delta
+        p_max = coarse.p_star[:, -1]
+        beyond = p_star >= p_max[:, None]
+        delta = interp(p_star, coarse.p_star, knots)
+        step = float(knots[0, 1] - knots[0, 0])
+        lo, hi = (delta - step).clamp_min(0.0), (delta + step).clamp_max(settings.delta_max)
+        tol = max(NEWTON_TOL, 64 * torch.finfo(p_star.dtype).eps) * p_star.abs()
+        for _ in range(NEWTON_STEPS):
+            sw = newton_fn(delta=delta)
+            if sw.load_slope is None:
+                raise ValueError("at_pressures needs a sweep_fn that gives load_slope")
+            resid = torch.where(beyond, 0.0, sw.p_star - p_star)
+            # converged points stay put: each point's Delta, and so a design's result, does
+            # not depend on the other rows of the batch
+            done = resid.abs() <= tol
+            if bool(done.all()):
+                break
+            slope = sw.load_slope
+            move = torch.where(~done & (slope > 0), resid / torch.where(slope > 0, slope, 1.0), 0.0)
+            delta = torch.minimum(torch.maximum(delta - move, lo), hi)
+    return delta, p_max
+
+
+def at_delta(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    p_star: Tensor,
+    delta: Tensor,
+    p_max: Tensor,
+    *,
+    sweep_fn: Callable[..., Sweep] | None = None,
+) -> Sweep:
+    """The response of (B, N) designs at the Deltas (B, M) that :func:`solve_delta` found
+    for p_star (B, M), with alpha moved to p_star; P*_max (B,) as it gave.
+
+    One Newton step in alpha at the converged, detached Delta: its value is alpha(p) to
+    second order in the residual, and its gradient is the implicit one, d alpha/d theta at
+    fixed p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
+    """
+    sw = (sweep_fn or sweep)(gamma, h, settings, delta=delta)
+    ok = (sw.stiffness > 0) & (p_star < p_max[:, None])
+    inv_s = torch.where(ok, 1.0 / torch.where(ok, sw.stiffness, 1.0), 0.0).detach()
+    return replace(sw, alpha=sw.alpha + (p_star - sw.p_star) * inv_s)
