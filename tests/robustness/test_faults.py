@@ -185,8 +185,11 @@ def test_design_interrupted_writes_all_or_nothing(tmp_path, sig):
     rc = proc.wait(120)
     names = sorted(p.name for p in out.iterdir()) if out.exists() else []
     assert names in ([], ["curve.csv", "design.json", "design.png"]), names
-    if rc != 0:
-        assert rc == 130 and names == []
+    if names:  # the run finished first: a signal during the interpreter's shutdown, after
+        # the files were whole, ends it with the default action (a loaded machine's timing)
+        assert rc in (0, -sig), rc
+    elif rc != 0:
+        assert rc == 130
         assert proc.stderr.read().strip().endswith("interrupted")
     assert not temporaries(tmp_path)
 
