@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 
 from metainterface._files.atomic import write_text
 from metainterface.data import generate_dataset, load_dataset
-from metainterface.data.dataset import Dataset
+from metainterface.data.load import Dataset
 from metainterface.designer.curves import design_curve
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import METHODS, builtin_target, design
