@@ -12,6 +12,8 @@ from metainterface._names import (
     METHOD_NAMES,
     MODEL_NAMES,
 )
+from metainterface.cli._design_options import command, manufacturing, settings, verify
+from metainterface.cli._design_report import table
 from metainterface.cli.common import add_device, positive_int
 
 
@@ -337,13 +339,13 @@ def run(args: argparse.Namespace) -> int:
         radius=args.radius,
         total_force=args.total_force,
         area=args.area if args.total_force is None else None,
-        settings=_settings(args),
-        meta=_command(args),
+        settings=settings(args),
+        meta=command(args),
         full_target=args.full_target,
         device=args.device,
         force=args.force,
-        verify=_verify(args),
-        **_manufacturing(args),
+        verify=verify(args),
+        **manufacturing(args),
     )
     try:
         results = _run(args, targets, options)
@@ -357,7 +359,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"warning: {note}", file=sys.stderr)
         if r.pressure is not None:
             print(f"{r.target.name} ({r.method}): {r.pressure.summary()}")
-    _table(args, results)
+    table(args, results)
     if args.html:  # one page per design folder
         from pathlib import Path
 
@@ -395,153 +397,3 @@ def _run(args: argparse.Namespace, targets: list, options: dict) -> list:
         )
         results = made if isinstance(made, list) else [made]
     return results
-
-
-def _table(args: argparse.Namespace, results: list) -> None:
-    """The summary table: errors (the one curve error), coverage and carrying asperities."""
-    width = max(len("target"), *(len(r.target.name) for r in results)) + 2
-    head = (
-        f"{'target':<{width}}{'method':<12}{'zero-shot':>11}{'error':>11}{'coverage':>10}"
-        f"{'carrying':>10}{'seconds':>9}"
-    )
-    checked = [r for r in results if r.bem is not None]
-    if checked:
-        head += f"{'BEM':>11}{'BEM s':>8}"
-    if args.robust:
-        head += f"{'made p50':>11}{'made p95':>11}"
-    if args.z_step is not None:
-        head += f"{'unsnapped':>11}{'snapped':>11}"
-    print(head)
-    for r in results:
-        line = (
-            f"{r.target.name:<{width}}{r.method:<12}{100 * r.initial_error:>9.3g} %"
-            f"{100 * r.error:>9.3g} %{100 * r.coverage:>8.3g} %"
-            f"{f'{r.carrying}/{r.design.n_asperities}':>10}{r.seconds:>9.2f}"
-        )
-        if r.robust:
-            line += f"{100 * r.robust['error_median']:>9.3g} %{100 * r.robust['error_p95']:>9.3g} %"
-        if r.printable:
-            q = r.printable
-            line += f"{100 * q['error_before_snap']:>9.3g} %{100 * q['error_after_snap']:>9.3g} %"
-        if r.bem is not None:
-            line += f"{100 * r.bem.bem_error:>9.3g} %{_bem_seconds(r):>8.1f}"
-        if r.forced:
-            line += "  FORCED (out of reach)"
-        print(line)
-    if args.robust:
-        print("error: the nominal design's; made p50/p95: of cells made with the errors given")
-    if args.z_step is not None:
-        print(
-            "unsnapped/snapped: before the snap to the layer grid and right after it; error: "
-            "after the shapes were re-refined"
-        )
-    print(
-        "error: sqrt(fit^2 + (1 - coverage)^2), fit over the loads the design reaches; "
-        "coverage: the share of the target's load range it reaches"
-    )
-    if checked:
-        print(_bem_legend(checked))
-
-
-def _verify(args: argparse.Namespace):
-    """The BEM check's settings from the options, or False with --no-verify."""
-    import metainterface as mi
-    from metainterface.verify import Verify
-
-    if not args.verify:
-        return False
-    if not 0 < args.max_bem_error <= 100:
-        raise mi.MetainterfaceError(
-            f"--max-bem-error must be a percentage in (0, 100], got {args.max_bem_error:g}"
-        )
-    return Verify(
-        grid=args.verify_grid,
-        loads=args.verify_loads,
-        correct=args.correct,
-        max_error=args.max_bem_error / 100,
-        engine=args.verify_engine,
-        device=args.device,
-    )
-
-
-def _bem_seconds(r) -> float:
-    """Wall time of a result's BEM solves [s]: the check, and the correction's."""
-    return (r.bem_before or r.bem).seconds + sum(c.seconds for c in r.corrections)
-
-
-def _bem_legend(results: list) -> str:
-    """What the BEM column is, in one line (with the corrections made)."""
-    b = results[0].bem
-    line = (
-        f"BEM: the design solved in BEM ({b.engine}, {b.grid}^2, {b.p_star.size} loads), "
-        "its error to the target"
-    )
-    fixed = [r for r in results if r.bem_before is not None and r.bem is not r.bem_before]
-    for r in fixed:
-        steps = ", ".join(
-            f"{100 * c.bem_error:.3g} %{'' if c.accepted else ' (not kept)'}" for c in r.corrections
-        )
-        line += (
-            f"; {r.target.name} corrected in BEM: {100 * r.bem_before.bem_error:.3g} % -> "
-            f"{100 * r.bem.bem_error:.3g} % (iterations: {steps})"
-        )
-    return line
-
-
-
-
-def _manufacturing(args: argparse.Namespace) -> dict:
-    """The robust-design and layer options, lengths in units of R (errors name the options)."""
-    import metainterface as mi
-    from metainterface.physical import parse_length
-    from metainterface.physical.printer import layer_step, length_in_r
-
-    radius = None if args.radius is None else parse_length(args.radius, option="--radius")
-    out: dict = {}
-    if args.z_step is not None:
-        delta_max = (_settings(args) or mi.CellSettings()).delta_max
-        out["z_step"] = layer_step(
-            args.z_step, radius, delta_max, option="--z-step", radius_option="--radius"
-        )
-    given = args.sigma_h is not None or args.sigma_gamma or args.scale_sigma
-    if not args.robust:
-        if given:
-            raise mi.MetainterfaceError("--sigma-h, --sigma-gamma, --scale-sigma need --robust")
-        return out
-    sigma_h = 0.0
-    if args.sigma_h is not None:
-        sigma_h = length_in_r(args.sigma_h, radius, option="--sigma-h", radius_option="--radius")
-    # --sigma-gamma, --scale-sigma and --robust-samples are checked by mi.design, whose
-    # errors carry the argument and so are shown under these option names
-    if sigma_h == args.sigma_gamma == args.scale_sigma == 0.0:
-        raise mi.MetainterfaceError("--robust needs --sigma-h, --sigma-gamma or --scale-sigma > 0")
-    out.update(
-        robust=True,
-        sigma_h=sigma_h,
-        sigma_gamma=args.sigma_gamma,
-        scale_sigma=args.scale_sigma,
-        robust_samples=args.robust_samples,
-    )
-    return out
-
-
-def _settings(args: argparse.Namespace):
-    """The cell from the design-space options, or None for the surrogate's own cell."""
-    import metainterface as mi
-
-    given = {
-        k: v
-        for k, v in (
-            ("n_asperities", args.n_asperities),
-            ("gamma_min", args.gamma_min),
-            ("gamma_max", args.gamma_max),
-            ("delta_max", args.delta_max),
-        )
-        if v is not None
-    }
-    return mi.CellSettings(**given) if given else None
-
-
-def _command(args: argparse.Namespace) -> dict:
-    """The options as given, recorded in design.json."""
-    return {k: v for k, v in vars(args).items() if k != "func"}

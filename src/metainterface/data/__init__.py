@@ -20,16 +20,13 @@ from metainterface.data.categories import (
     sample_truncated,
 )
 from metainterface.data.dataset import (
-    FORMAT,
-    SPLITS,
-    Dataset,
     GenerationReport,
     allocate,
     generate_dataset,
-    load_dataset,
     sort_and_anchor,
     split_counts,
 )
+from metainterface.data.load import FORMAT, SPLITS, Dataset, load_dataset
 
 __all__ = [
     "CATEGORIES",

@@ -21,75 +21,28 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import special
 from scipy.stats import qmc
 
+from metainterface.data._draws import (
+    anchor_group,
+    check_params,
+    first,
+    full_gamma,
+    group_sizes,
+    require,
+    truncated_exponential_ppf,
+    truncated_normal_ppf,
+    uniform,
+    uniform_above,
+)
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 
 Sampler = Callable[[np.random.Generator, int, CellSettings, Any], tuple[np.ndarray, np.ndarray]]
-
-
-# -- parameter validation -------------------------------------------------------------------
-
-
-def _check_params(obj: Any) -> None:
-    """Shared checks: every float finite and >= 0, every int >= 0 (names the field)."""
-    for f in fields(obj):
-        value = getattr(obj, f.name)
-        if isinstance(value, bool):
-            continue
-        if isinstance(value, int):
-            if value < 0:
-                raise MetainterfaceError(f"{type(obj).__name__}.{f.name} must be >= 0, got {value}")
-        elif isinstance(value, float) and not (math.isfinite(value) and value >= 0):
-            raise MetainterfaceError(
-                f"{type(obj).__name__}.{f.name} must be a finite number >= 0, got {value}"
-            )
-
-
-def _require(cond: bool, obj: Any, text: str) -> None:
-    if not cond:
-        raise MetainterfaceError(f"{type(obj).__name__}: {text}")
-
-
-# -- shared helpers -------------------------------------------------------------------------
-
-
-def _uniform(rng: np.random.Generator, low: float, high: float, size: Any) -> np.ndarray:
-    """Uniform on [low, high)."""
-    return low + (high - low) * rng.random(size)
-
-
-def _uniform_above(rng: np.random.Generator, low: float, high: float, size: Any) -> np.ndarray:
-    """Uniform on (low, high]: strictly above ``low``."""
-    return high - (high - low) * rng.random(size)
-
-
-def _full_gamma(rng: np.random.Generator, count: int, settings: CellSettings) -> np.ndarray:
-    """(count, N) shape exponents uniform on [gamma_min, gamma_max)."""
-    return _uniform(rng, settings.gamma_min, settings.gamma_max, (count, settings.n_asperities))
-
-
-def _group_sizes(rng: np.random.Generator, count: int, low: int, high: int, n: int) -> np.ndarray:
-    """(count,) integers uniform on [low, high], both clipped to [0, n]."""
-    low, high = min(max(low, 0), n), min(max(high, 0), n)
-    return rng.integers(low, max(low, high), size=count, endpoint=True)
-
-
-def _first(k: np.ndarray, n: int) -> np.ndarray:
-    """(count, n) mask of the first k[i] columns of row i."""
-    return np.arange(n) < k[:, None]
-
-
-def _anchor_group(h: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """Subtract from the masked entries of each row their row minimum (rows with none: as is)."""
-    low = np.where(mask, h, np.inf).min(axis=1, keepdims=True)
-    return np.where(mask, h - np.where(np.isfinite(low), low, 0.0), h)
 
 
 # -- (a) Latin hypercube --------------------------------------------------------------------
@@ -108,8 +61,8 @@ class LHSParams:
     h_max: float = 1.0
 
     def __post_init__(self) -> None:
-        _check_params(self)
-        _require(self.h_max > 0, self, f"h_max must be > 0, got {self.h_max}")
+        check_params(self)
+        require(self.h_max > 0, self, f"h_max must be > 0, got {self.h_max}")
 
 
 def sample_lhs(
@@ -156,13 +109,13 @@ class TruncatedParams:
     inactive_h_max: float = 1.5
 
     def __post_init__(self) -> None:
-        _check_params(self)
-        _require(
+        check_params(self)
+        require(
             1 <= self.active_min <= self.active_max,
             self,
             f"need 1 <= active_min <= active_max, got {self.active_min}, {self.active_max}",
         )
-        _require(
+        require(
             self.active_h_max <= 1.0 < self.inactive_h_min < self.inactive_h_max,
             self,
             "need active_h_max <= 1 < inactive_h_min < inactive_h_max, got "
@@ -181,14 +134,14 @@ def sample_truncated(
     Returns (gamma, h), both (count, N). After anchoring, the lowest active asperity is at 0.
     """
     n, dmax = settings.n_asperities, settings.delta_max
-    gamma = _full_gamma(rng, count, settings)
-    k = _group_sizes(rng, count, params.active_min, params.active_max, n)
-    active = _first(k, n)
-    h_active = _uniform(rng, 0.0, params.active_h_max * dmax, (count, n))
-    h_inactive = _uniform_above(
+    gamma = full_gamma(rng, count, settings)
+    k = group_sizes(rng, count, params.active_min, params.active_max, n)
+    active = first(k, n)
+    h_active = uniform(rng, 0.0, params.active_h_max * dmax, (count, n))
+    h_inactive = uniform_above(
         rng, params.inactive_h_min * dmax, params.inactive_h_max * dmax, (count, n)
     )
-    h = _anchor_group(np.where(active, h_active, h_inactive), active)
+    h = anchor_group(np.where(active, h_active, h_inactive), active)
     return gamma, h
 
 
@@ -216,19 +169,19 @@ class BimodalParams:
     blunt_min: int = 1
 
     def __post_init__(self) -> None:
-        _check_params(self)
-        _require(
+        check_params(self)
+        require(
             0 < self.gamma_fraction <= 0.5,
             self,
             f"gamma_fraction must be in (0, 0.5], got {self.gamma_fraction}",
         )
-        _require(
+        require(
             0 < self.soft_h_max <= self.blunt_h_min < self.blunt_h_max,
             self,
             "need 0 < soft_h_max <= blunt_h_min < blunt_h_max, got "
             f"{self.soft_h_max}, {self.blunt_h_min}, {self.blunt_h_max}",
         )
-        _require(self.soft_min >= 1, self, f"soft_min must be >= 1, got {self.soft_min}")
+        require(self.soft_min >= 1, self, f"soft_min must be >= 1, got {self.soft_min}")
 
 
 def sample_bimodal(
@@ -243,19 +196,19 @@ def sample_bimodal(
     """
     n, dmax = settings.n_asperities, settings.delta_max
     band = params.gamma_fraction * (settings.gamma_max - settings.gamma_min)
-    k = _group_sizes(rng, count, params.soft_min, n - params.blunt_min, n)
-    soft = _first(k, n)
+    k = group_sizes(rng, count, params.soft_min, n - params.blunt_min, n)
+    soft = first(k, n)
     gamma = np.where(
         soft,
-        _uniform(rng, settings.gamma_min, settings.gamma_min + band, (count, n)),
-        _uniform_above(rng, settings.gamma_max - band, settings.gamma_max, (count, n)),
+        uniform(rng, settings.gamma_min, settings.gamma_min + band, (count, n)),
+        uniform_above(rng, settings.gamma_max - band, settings.gamma_max, (count, n)),
     )
     h = np.where(
         soft,
-        _uniform(rng, 0.0, params.soft_h_max * dmax, (count, n)),
-        _uniform_above(rng, params.blunt_h_min * dmax, params.blunt_h_max * dmax, (count, n)),
+        uniform(rng, 0.0, params.soft_h_max * dmax, (count, n)),
+        uniform_above(rng, params.blunt_h_min * dmax, params.blunt_h_max * dmax, (count, n)),
     )
-    return gamma, _anchor_group(h, soft)
+    return gamma, anchor_group(h, soft)
 
 
 # -- (d) stratified heights -----------------------------------------------------------------
@@ -278,14 +231,14 @@ class StratifiedParams:
     cluster_h_max: float = 1.0
 
     def __post_init__(self) -> None:
-        _check_params(self)
-        _require(self.low_min >= 1, self, f"low_min must be >= 1, got {self.low_min}")
-        _require(
+        check_params(self)
+        require(self.low_min >= 1, self, f"low_min must be >= 1, got {self.low_min}")
+        require(
             self.low_fraction <= 1,
             self,
             f"low_fraction must be in [0, 1], got {self.low_fraction}",
         )
-        _require(
+        require(
             0 < self.split_h < self.cluster_h_max,
             self,
             f"need 0 < split_h < cluster_h_max, got {self.split_h}, {self.cluster_h_max}",
@@ -303,16 +256,16 @@ def sample_stratified(
     Gammas uniform on [gamma_min, gamma_max). Returns (gamma, h), both (count, N).
     """
     n, dmax = settings.n_asperities, settings.delta_max
-    gamma = _full_gamma(rng, count, settings)
+    gamma = full_gamma(rng, count, settings)
     high = max(params.low_min, math.floor(params.low_fraction * n + 1e-9))
-    k = _group_sizes(rng, count, params.low_min, high, n)
-    low = _first(k, n)
+    k = group_sizes(rng, count, params.low_min, high, n)
+    low = first(k, n)
     h = np.where(
         low,
-        _uniform(rng, 0.0, params.split_h * dmax, (count, n)),
-        _uniform(rng, params.split_h * dmax, params.cluster_h_max * dmax, (count, n)),
+        uniform(rng, 0.0, params.split_h * dmax, (count, n)),
+        uniform(rng, params.split_h * dmax, params.cluster_h_max * dmax, (count, n)),
     )
-    return gamma, _anchor_group(h, low)
+    return gamma, anchor_group(h, low)
 
 
 # -- (e) coplanar arrays --------------------------------------------------------------------
@@ -337,14 +290,14 @@ class CoplanarParams:
     rest_h_max: float = 1.0
 
     def __post_init__(self) -> None:
-        _check_params(self)
-        _require(
+        check_params(self)
+        require(
             self.all_probability <= 1,
             self,
             f"all_probability must be in [0, 1], got {self.all_probability}",
         )
-        _require(self.min_count >= 1, self, f"min_count must be >= 1, got {self.min_count}")
-        _require(
+        require(self.min_count >= 1, self, f"min_count must be >= 1, got {self.min_count}")
+        require(
             0 < self.coplanar_h_max < self.rest_h_max,
             self,
             f"need 0 < coplanar_h_max < rest_h_max, got {self.coplanar_h_max}, {self.rest_h_max}",
@@ -362,19 +315,19 @@ def sample_coplanar(
     Returns (gamma, h), both (count, N).
     """
     n, dmax = settings.n_asperities, settings.delta_max
-    gamma = _full_gamma(rng, count, settings)
+    gamma = full_gamma(rng, count, settings)
     k = np.where(
         rng.random(count) < params.all_probability,
         n,
-        _group_sizes(rng, count, params.min_count, n, n),
+        group_sizes(rng, count, params.min_count, n, n),
     )
-    flat = _first(k, n)
+    flat = first(k, n)
     h = np.where(
         flat,
-        _uniform(rng, 0.0, params.coplanar_h_max * dmax, (count, n)),
-        _uniform(rng, params.coplanar_h_max * dmax, params.rest_h_max * dmax, (count, n)),
+        uniform(rng, 0.0, params.coplanar_h_max * dmax, (count, n)),
+        uniform(rng, params.coplanar_h_max * dmax, params.rest_h_max * dmax, (count, n)),
     )
-    return gamma, _anchor_group(h, flat)
+    return gamma, anchor_group(h, flat)
 
 
 # -- (f) mixed stochastic depths ------------------------------------------------------------
@@ -405,25 +358,16 @@ class MixedParams:
     exp_scale: float = 0.25
 
     def __post_init__(self) -> None:
-        _check_params(self)
+        check_params(self)
         w = tuple(float(x) for x in self.weights)
-        _require(
+        require(
             len(w) == 3 and all(math.isfinite(x) and x >= 0 for x in w) and sum(w) > 0,
             self,
             f"weights must be 3 numbers >= 0 with a positive sum, got {self.weights}",
         )
         object.__setattr__(self, "weights", w)
         for name in ("h_max", "gauss_sd", "exp_scale"):
-            _require(getattr(self, name) > 0, self, f"{name} must be > 0")
-
-
-def _truncated_normal_ppf(u: np.ndarray, mean: float, sd: float, high: float) -> np.ndarray:
-    lo, hi = special.ndtr((0.0 - mean) / sd), special.ndtr((high - mean) / sd)
-    return mean + sd * special.ndtri(lo + u * (hi - lo))
-
-
-def _truncated_exponential_ppf(u: np.ndarray, scale: float, high: float) -> np.ndarray:
-    return -scale * np.log1p(-u * -np.expm1(-high / scale))
+            require(getattr(self, name) > 0, self, f"{name} must be > 0")
 
 
 def sample_mixed(
@@ -438,7 +382,7 @@ def sample_mixed(
     dataset, like for the LHS).
     """
     n, dmax = settings.n_asperities, settings.delta_max
-    gamma = _full_gamma(rng, count, settings)
+    gamma = full_gamma(rng, count, settings)
     w = np.asarray(params.weights) / sum(params.weights)
     law = rng.choice(3, size=(count, 1) if params.per_sample else (count, n), p=w)
     u = rng.random((count, n))
@@ -447,8 +391,8 @@ def sample_mixed(
         law,
         [
             u * high,
-            _truncated_normal_ppf(u, params.gauss_mean * dmax, params.gauss_sd * dmax, high),
-            _truncated_exponential_ppf(u, params.exp_scale * dmax, high),
+            truncated_normal_ppf(u, params.gauss_mean * dmax, params.gauss_sd * dmax, high),
+            truncated_exponential_ppf(u, params.exp_scale * dmax, high),
         ],
     )
     return gamma, np.clip(h, 0.0, high)

@@ -1,4 +1,5 @@
-"""The synthetic training dataset (paper sec. 2.4): generate it into one .npz, load it back.
+"""The synthetic training dataset (paper sec. 2.4): generate it into one .npz
+(read back by ``metainterface.data.load``).
 
 A dataset of S samples of an N-asperity cell holds, per sample, the design sorted by height
 (gamma moving with its h) and anchored so min h = 0, and its exact alpha(P*) curve in the
@@ -26,7 +27,7 @@ import time
 from collections import deque
 from collections.abc import Iterator, Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -38,29 +39,15 @@ from metainterface._files.atomic import atomic_open, ensure_parent
 from metainterface._files.provenance import provenance
 from metainterface.data.categories import CATEGORIES, CATEGORY_NAMES
 from metainterface.data.categories import category as find_category
+from metainterface.data.load import CURVE_ARRAYS, FORMAT, SPLIT_FRACTIONS, SPLITS
 from metainterface.data.npz import NpzStreamWriter
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import curves_numpy
 
-FORMAT = "metainterface/dataset-v1"
-SPLITS: tuple[str, ...] = ("train", "val", "test")
-SPLIT_FRACTIONS: tuple[float, ...] = (0.8, 0.1, 0.1)  # implemented by split_counts
-ARRAYS: tuple[str, ...] = (
-    "gamma",
-    "h",
-    "category",
-    "split",
-    "p_star_max",
-    "alpha_max",
-    "alpha_hat",
-    "stiffness_hat",
-    "meta",
-)
 DEFAULT_CHUNK = 4096  # samples sampled, computed and written together
 _CURVE_CHUNK = 256  # curves_numpy's inner chunk: small temporaries keep the peak RSS low
 DEFAULT_BLOCK = 32768  # largest block one generator draws (fixes the LHS partition)
-_CURVE_ARRAYS = ("p_star_max", "alpha_max", "alpha_hat", "stiffness_hat")
 
 
 def allocate(total: int, fractions: Sequence[float]) -> np.ndarray:
@@ -368,7 +355,7 @@ def generate_dataset(
                 writer.write("h", h)
                 writer.write("category", cat_names[cat])
                 writer.write("split", split_names[split])
-                for name in _CURVE_ARRAYS:
+                for name in CURVE_ARRAYS:
                     writer.write(name, curves[name])
                 if examples:
                     curves.update(gamma=gamma, h=h)
@@ -413,7 +400,7 @@ def generate_dataset(
 def check_curves(curves: Mapping[str, np.ndarray], settings: CellSettings, first_row: int) -> None:
     """Refuse curves that are not finite, or whose scales are not positive (float32 underflow
     or overflow for an extreme cell): a dataset never holds a silent NaN."""
-    for name in _CURVE_ARRAYS:
+    for name in CURVE_ARRAYS:
         values = np.asarray(curves[name])
         bad = ~np.isfinite(values)
         if name in ("p_star_max", "alpha_max"):
@@ -425,154 +412,3 @@ def check_curves(curves: Mapping[str, np.ndarray], settings: CellSettings, first
                 f"(delta_max {settings.delta_max:g}, radius {settings.radius:g}, gamma in "
                 f"[{settings.gamma_min:g}, {settings.gamma_max:g}]); nothing written"
             )
-
-
-# -- loading --------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Dataset:
-    """A loaded dataset: the arrays of the file (see the module docstring), its settings, meta.
-
-    S samples; gamma, h (S, N); category, split (S,) str; p_star_max, alpha_max (S,);
-    alpha_hat, stiffness_hat (S, n_steps). ``subset`` selects rows by split and/or category.
-    """
-
-    gamma: np.ndarray
-    h: np.ndarray
-    category: np.ndarray
-    split: np.ndarray
-    p_star_max: np.ndarray
-    alpha_max: np.ndarray
-    alpha_hat: np.ndarray
-    stiffness_hat: np.ndarray
-    settings: CellSettings
-    meta: dict[str, Any] = field(repr=False)
-    path: Path | None = None
-
-    def __len__(self) -> int:
-        return int(self.gamma.shape[0])
-
-    @property
-    def seed(self) -> int:
-        return int(self.meta["settings"]["seed"])
-
-    def subset(self, split: str | None = None, *, category: str | None = None) -> Dataset:
-        """The rows of one split ('train', 'val' or 'test') and/or one category, in file order."""
-        keep = np.ones(len(self), dtype=bool)
-        if split is not None:
-            if split not in SPLITS:
-                raise MetainterfaceError(
-                    f"unknown split {split!r}, expected one of {', '.join(SPLITS)}"
-                )
-            keep &= self.split == split
-        if category is not None:
-            keep &= self.category == find_category(category).name
-        return replace(self, **{name: getattr(self, name)[keep] for name in _ROW_ARRAYS})
-
-
-_ROW_ARRAYS = tuple(name for name in ARRAYS if name != "meta")
-
-
-def load_dataset(path: str | os.PathLike[str], settings: CellSettings | None = None) -> Dataset:
-    """Read and check a dataset file; with ``settings``, the file's cell must equal them.
-
-    Raises a one-line MetainterfaceError naming the file and what is missing, malformed or
-    different (each differing setting with both values).
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise MetainterfaceError(f"{path}: file not found")
-    try:
-        with path.open("rb") as fh:
-            magic = fh.read(4)
-    except OSError as exc:
-        raise MetainterfaceError(f"{path}: cannot read ({exc.strerror})") from None
-    if magic != b"PK\x03\x04":  # np.load would try .npy and pickle content next
-        raise MetainterfaceError(
-            f"{path}: not a .npz dataset (not a zip archive); make one with "
-            "`metainterface generate`"
-        )
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            missing = [name for name in ARRAYS if name not in npz.files]
-            if missing:
-                raise MetainterfaceError(
-                    f"{path}: missing array(s) {', '.join(missing)} "
-                    f"(a dataset holds {', '.join(ARRAYS)})"
-                )
-            arrays = {name: npz[name] for name in ARRAYS}
-    except MetainterfaceError:
-        raise
-    except Exception as exc:  # zipfile.BadZipFile, ValueError, OSError, ...
-        first = " ".join(str(exc).split())[:120] or type(exc).__name__
-        raise MetainterfaceError(f"{path}: not a readable .npz dataset ({first})") from None
-
-    try:
-        meta = json.loads(str(arrays.pop("meta")[()]))
-        recorded = meta["settings"]
-        cell = recorded["cell"]
-    except (json.JSONDecodeError, KeyError, TypeError, IndexError):
-        raise MetainterfaceError(
-            f"{path}: meta is not a dataset record (no cell settings)"
-        ) from None
-    if recorded.get("format") != FORMAT:
-        raise MetainterfaceError(
-            f"{path}: meta format is {recorded.get('format')!r}, expected {FORMAT!r}"
-        )
-    try:
-        file_settings = CellSettings(**cell)
-    except (MetainterfaceError, TypeError) as exc:
-        raise MetainterfaceError(f"{path}: meta has invalid cell settings: {exc}") from None
-
-    s = arrays["gamma"].shape[0] if arrays["gamma"].ndim else -1
-    n, steps = file_settings.n_asperities, file_settings.n_steps
-    expected = {
-        "gamma": (s, n),
-        "h": (s, n),
-        "category": (s,),
-        "split": (s,),
-        "p_star_max": (s,),
-        "alpha_max": (s,),
-        "alpha_hat": (s, steps),
-        "stiffness_hat": (s, steps),
-    }
-    for name, shape in expected.items():
-        if arrays[name].shape != shape:
-            raise MetainterfaceError(
-                f"{path}: array {name} has shape {arrays[name].shape}, expected {shape} "
-                f"(N = {n}, n_steps = {steps})"
-            )
-    for name, allowed in (("category", CATEGORY_NAMES), ("split", SPLITS)):
-        bad = np.setdiff1d(np.unique(arrays[name]), allowed)
-        if bad.size:
-            raise MetainterfaceError(
-                f"{path}: array {name} holds unknown value {str(bad[0])!r}, "
-                f"expected {', '.join(allowed)}"
-            )
-
-    for name in ("gamma", "h", *_CURVE_ARRAYS):
-        if arrays[name].dtype.kind not in "fiu":
-            raise MetainterfaceError(f"{path}: array {name} is not numeric")
-        bad = ~np.isfinite(arrays[name])
-        if name in ("p_star_max", "alpha_max"):
-            bad |= ~(arrays[name] > 0)
-        if bad.any():
-            row = int(np.flatnonzero(bad.reshape(s, -1).any(axis=1))[0])
-            raise MetainterfaceError(
-                f"{path}: row {row} of {name} is not a finite"
-                f"{' positive' if name in ('p_star_max', 'alpha_max') else ''} number; "
-                "the dataset cannot be used"
-            )
-
-    if settings is not None:
-        diffs = [
-            f"{f.name} is {getattr(file_settings, f.name)!r} in the file, expected "
-            f"{getattr(settings, f.name)!r}"
-            for f in fields(CellSettings)
-            if getattr(file_settings, f.name) != getattr(settings, f.name)
-        ]
-        if diffs:
-            raise MetainterfaceError(f"{path}: settings differ: {'; '.join(diffs)}")
-
-    return Dataset(**arrays, settings=file_settings, meta=meta, path=path)

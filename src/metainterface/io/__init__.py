@@ -5,16 +5,7 @@ Design files (design-v1 JSON) are read and written by :class:`~metainterface.Des
 (``Design.load`` / ``Design.save``); CSV columns and atomic writes are ``metainterface._files``.
 """
 
-from metainterface.io.export import (
-    FORMATS,
-    Patch,
-    export_design,
-    format_for,
-    height_patch,
-    parse_tiles,
-    patch_mesh,
-    sidecar_path,
-)
+from metainterface.io.export import FORMATS, export_design, format_for, sidecar_path
 from metainterface.io.fields import (
     FIELDS_FILE,
     fields_dataset,
@@ -22,6 +13,8 @@ from metainterface.io.fields import (
     require_xarray,
     write_fields,
 )
+from metainterface.io.patch import Patch, height_patch, parse_tiles
+from metainterface.io.stl import patch_mesh
 
 __all__ = [
     "FIELDS_FILE",

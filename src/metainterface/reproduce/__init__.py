@@ -92,7 +92,7 @@ def reproduce(
     and the progress bars of long steps on stderr.
     """
     from metainterface import __version__
-    from metainterface.reproduce import report, stages
+    from metainterface.reproduce import context, report, stages
     from metainterface.surrogate.checkpoint import default_model_path
 
     sc = get_scale(scale, quick)
@@ -112,7 +112,7 @@ def reproduce(
         else:
             work = Path(work_dir)
             work.mkdir(parents=True, exist_ok=True)
-        ctx = stages.Context(out, work, sc, model, progress, command)
+        ctx = context.Context(out, work, sc, model, progress, command)
         started = time.perf_counter()
         for k, name in enumerate(names, 1):
             func, what, _ = stages.STAGES[name]
@@ -128,7 +128,7 @@ def reproduce(
                     flush=True,
                 )
     record = provenance(
-        command=command, scale=sc.to_dict(), model=stages.model_label(model), stages=names
+        command=command, scale=sc.to_dict(), model=context.model_label(model), stages=names
     )
     header = {
         "command": command,

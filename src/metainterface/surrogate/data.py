@@ -8,7 +8,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from metainterface.data.dataset import Dataset
+from metainterface.data.load import Dataset
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.curves import features_from_normalised
 from metainterface.surrogate.loss import CurveTargets

@@ -32,6 +32,7 @@ from metainterface.io.fields import FIELDS_FILE, require_xarray
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, get_model
 from metainterface.sweep.validate import request_hash, write_result
+from metainterface.validation.batched import solve_batched
 from metainterface.validation.bem import (
     MAX_ITER,
     TOLERANCE,
@@ -46,7 +47,6 @@ from metainterface.validation.validate import (
     ValidationPlan,
     check_jobs,
     plan_validation,
-    solve_batched,
 )
 
 #: Columns of summary.csv, one row per design.
