@@ -14,7 +14,8 @@ after correction per grid, the corrected design's model error, and the wall time
 design and of the BEM work per grid.
 
 Run: python benchmarks/bench_verified.py [--grids 384 768] [--n-random 30] [--loads 10]
-     [--iterations 3] [--engine torch] [--device auto] [--cross] [--out results/verified.md]
+     [--iterations 3] [--inner interacting] [--engine torch] [--device auto] [--cross]
+     [--out results/verified.md]
      python benchmarks/bench_verified.py --quick    (192^2, 6 loads, 3 random targets)
 """
 
@@ -68,6 +69,7 @@ def run_target(r, grids: list[int], args: argparse.Namespace) -> dict:
             loads=args.loads,
             correct=True,
             iterations=args.iterations,
+            inner=None if args.inner == "design" else args.inner,
             engine=args.engine,
             device=args.device,
         )
@@ -152,6 +154,12 @@ def main() -> None:
     ap.add_argument("--n-random", type=int, help="held-out random targets (30)")
     ap.add_argument("--loads", type=int, help="loads of each check (10)")
     ap.add_argument("--iterations", type=int, default=3, help="BEM solves of a correction (3)")
+    ap.add_argument(
+        "--inner",
+        default="interacting",
+        help="the correction's model: interacting (default), independent, or design (the "
+        "design's own)",
+    )
     ap.add_argument("--engine", default="torch", help="contact solver (torch)")
     ap.add_argument("--device", default="auto", help="torch engine's device (auto)")
     ap.add_argument("--no-analytic", action="store_true", help="leave out the analytic laws")
@@ -193,8 +201,8 @@ def main() -> None:
             f"`{command}`; torch {torch.__version__}, {threads} threads, "
             f"OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', 'unset')}, engine "
             f"{rows[0]['engine']}, {args.loads} loads, correction up to "
-            f"{args.iterations} BEM solves. {len(targets)} targets designed in one call in "
-            f"{t_design:.1f} s.",
+            f"{args.iterations} BEM solves on the {args.inner} model. {len(targets)} targets "
+            f"designed in one call in {t_design:.1f} s.",
             "",
             text,
             "",

@@ -191,6 +191,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--no-correct", dest="correct", action="store_false", help="never correct in BEM"
     )
     check.add_argument(
+        "--correct-model",
+        choices=[*MODEL_NAMES, "design"],
+        default="interacting",
+        help="the forward model the correction re-refines on: interacting (default; its "
+        "defect to the BEM is smaller), independent, or design (the design's own --physics)",
+    )
+    check.add_argument(
         "--max-bem-error",
         type=float,
         default=2.0,
@@ -458,6 +465,7 @@ def _verify(args: argparse.Namespace):
         grid=args.verify_grid,
         loads=args.verify_loads,
         correct=args.correct,
+        inner=None if args.correct_model == "design" else args.correct_model,
         max_error=args.max_bem_error / 100,
         engine=args.verify_engine,
         device=args.device,
@@ -486,8 +494,6 @@ def _bem_legend(results: list) -> str:
             f"{100 * r.bem.bem_error:.3g} % (iterations: {steps})"
         )
     return line
-
-
 
 
 def _manufacturing(args: argparse.Namespace) -> dict:
