@@ -13,7 +13,12 @@ from metainterface.cli import main
 from metainterface.physics.models import get_model
 from metainterface.verify import BemCheck, Verify, bem_check
 from metainterface.verify.check import curve_error
-from metainterface.verify.correct import model_error, shifted_target
+from metainterface.verify.correct import (
+    curve_fit_error,
+    fresh_design,
+    model_error,
+    shifted_target,
+)
 
 # at 96^2 the BEM reads the bilinear design ~5 % high by itself (the grid), hence max_error
 QUICK = Verify(grid=96, loads=4, correct=False, max_error=0.1)
@@ -120,6 +125,25 @@ def test_the_correction_runs_on_the_model_asked_for(corrected):
     assert corrected.error == pytest.approx(on_design_model, rel=1e-9)
 
 
+def test_each_iteration_says_where_its_design_came_from(corrected):
+    # the default also designs afresh against the shifted target; restart=False only
+    # re-refines the kept design
+    assert {c.start for c in corrected.corrections} <= {"current", "fresh"}
+    s = Verify(grid=96, loads=4, correct=True, iterations=2, restart=False)
+    r = mi.design("bilinear", verify=s)
+    assert [c.start for c in r.corrections] == ["current"] * len(r.corrections)
+    assert r.corrections[0].to_dict()["start"] == "current"
+
+
+def test_a_fresh_design_meets_a_realisable_shifted_target():
+    r = mi.design("saturating", verify=False)
+    fm = get_model("interacting")
+    curve = fm.model_curve(r.design)
+    fresh = fresh_design((curve.p_star, curve.alpha), r.design.settings, fm, seed=0)
+    assert fresh is not None
+    assert curve_fit_error(fresh, (curve.p_star, curve.alpha), fm) < 0.01
+
+
 def test_cli_correct_model_reaches_the_correction(tmp_path, capsys):
     args = ["design", "--target", "bilinear", "--verify-grid", "96", "--verify-loads", "4"]
     args += ["--correct", "--max-bem-error", "10"]
@@ -147,6 +171,7 @@ def test_cli_correct_model_reaches_the_correction(tmp_path, capsys):
         ({"correct": "yes"}, "correct"),
         ({"device": 3}, "device"),
         ({"inner": "fem"}, "inner"),
+        ({"restart": "yes"}, "restart"),
     ],
 )
 def test_bad_settings_give_one_line_naming_the_field(kwargs, name):

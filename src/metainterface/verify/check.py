@@ -72,6 +72,11 @@ class Verify:
         model): ``"interacting"`` (default), ``"independent"`` or another registered model's
         name; None: the model the design was made with. The reported model error stays on
         the design's model.
+    restart : bool
+        Each correction iteration also designs afresh against the shifted target (the
+        surrogate and its hedge starts, on the correction's model) and keeps whichever
+        design meets it better in that model (default True; no extra BEM solve). Not for
+        the Hertz baseline or heights fixed on a printer's layers.
     max_error : float
         The BEM error a design is trusted within (0.02 = 2 %), in (0, 1]; above it the result
         says so (``DesignResult.bem_ok``) and the command line exits with status 3.
@@ -86,6 +91,7 @@ class Verify:
     correct: bool | None = None
     iterations: int = 3
     inner: str | None = DEFAULT_INNER
+    restart: bool = True
     max_error: float = 0.02
     engine: str = DEFAULT_ENGINE
     device: str = "auto"
@@ -100,6 +106,10 @@ class Verify:
                 argument="correct",
             )
         _checks.whole("iterations", self.iterations, low=1, high=MAX_ITERATIONS)
+        if not isinstance(self.restart, bool):
+            raise MetainterfaceError(
+                f"restart must be True or False, got {self.restart!r}", argument="restart"
+            )
         if self.inner is not None:
             _checks.choice("inner", self.inner, MODELS)
         _checks.number("max_error", self.max_error, low=0.0, low_open=True, high=1.0)
