@@ -164,10 +164,14 @@ def fresh_design(
 
 
 def curve_fit_error(
-    design: Design, curve: tuple[np.ndarray, np.ndarray], model: ForwardModel
+    design: Design,
+    curve: tuple[np.ndarray, np.ndarray],
+    model: ForwardModel,
+    points: int | None = None,
 ) -> float:
-    """The design's relative error to ``curve`` (p_star, alpha) on ``model``."""
-    grid = TargetGrid.from_curves([curve], RefineSettings().grid_points)
+    """The design's relative error to ``curve`` (p_star, alpha) on ``model``, on the
+    refinement's grid (``points``, default ``RefineSettings().grid_points``)."""
+    grid = TargetGrid.from_curves([curve], points or RefineSettings().grid_points)
     gamma = torch.as_tensor(design.gamma, dtype=DTYPE)[None]
     h = torch.as_tensor(design.h, dtype=DTYPE)[None]
     return float(relative_error(gamma, h, design.settings, grid, model)[0])
@@ -177,12 +181,7 @@ def model_error(
     design: Design, target: Target, model: ForwardModel, points: int | None = None
 ) -> float:
     """The design's model error to the target on the refinement's grid (``design``'s measure)."""
-    grid = TargetGrid.from_curves(
-        [(target.p_star, target.alpha)], points or RefineSettings().grid_points
-    )
-    gamma = torch.as_tensor(design.gamma, dtype=DTYPE)[None]
-    h = torch.as_tensor(design.h, dtype=DTYPE)[None]
-    return float(relative_error(gamma, h, design.settings, grid, model)[0])
+    return curve_fit_error(design, (target.p_star, target.alpha), model, points)
 
 
 def alpha_at(design: Design, model: ForwardModel, p_star: np.ndarray) -> np.ndarray:
@@ -207,9 +206,8 @@ def correct(
     Spends at most ``settings.iterations`` BEM solves; param, extra_loss and refine_settings
     are those the design was refined with (the Hertz baseline keeps gamma = 2, a design on a
     printer's layers keeps its heights; neither is designed afresh). model: the one the design
-    was made with (``check``'s,
-    and the one the returned checks and model errors are on); the re-refinement runs on
-    ``settings.inner`` (None: this one).
+    was made with (``check``'s, and the one the returned checks and model errors are on);
+    the re-refinement runs on ``settings.inner`` (None: this one).
     """
     settings = settings or Verify()
     fm = get_model(model)
