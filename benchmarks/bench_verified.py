@@ -5,16 +5,19 @@ random cells, gamma uniform in the bounds and h uniform in [0, Delta_max], seed 
 the training set's generator or seed) and five analytic laws. Each target is designed with
 the CLI's defaults (surrogate, hedge 8, fallback 50; verify=False), then, at each grid of
 --grids, checked in BEM at --loads loads over the target's range (``verify.bem_check``) and
-corrected there (``verify.correct``, up to --iterations BEM solves). With --cross, a design
-corrected at the first grid is also measured at the last one (does the correction carry to
-the finer grid, or did it fit the coarse grid's own error?).
+corrected there (``verify.correct``, up to --iterations BEM solves, re-refined on the
+--inner model, with a fresh design per iteration unless --no-restart; ``--inner design
+--no-restart`` is the first scheme: the design's own model, from the kept design). With
+--cross, a design corrected at the first grid is also measured at the last one (does the
+correction carry to the finer grid, or did it fit the coarse grid's own error?).
 
 Columns: the model error (on the refinement's 128-point grid), the BEM error before and
 after correction per grid, the corrected design's model error, and the wall time of the
 design and of the BEM work per grid.
 
 Run: python benchmarks/bench_verified.py [--grids 384 768] [--n-random 30] [--loads 10]
-     [--iterations 3] [--engine torch] [--device auto] [--cross] [--out results/verified.md]
+     [--iterations 3] [--inner interacting] [--no-restart] [--engine torch] [--device auto]
+     [--cross] [--out results/verified.md]
      python benchmarks/bench_verified.py --quick    (192^2, 6 loads, 3 random targets)
 """
 
@@ -68,6 +71,8 @@ def run_target(r, grids: list[int], args: argparse.Namespace) -> dict:
             loads=args.loads,
             correct=True,
             iterations=args.iterations,
+            inner=None if args.inner == "design" else args.inner,
+            restart=not args.no_restart,
             engine=args.engine,
             device=args.device,
         )
@@ -152,6 +157,17 @@ def main() -> None:
     ap.add_argument("--n-random", type=int, help="held-out random targets (30)")
     ap.add_argument("--loads", type=int, help="loads of each check (10)")
     ap.add_argument("--iterations", type=int, default=3, help="BEM solves of a correction (3)")
+    ap.add_argument(
+        "--inner",
+        default="interacting",
+        help="the correction's model: interacting (default), independent, or design (the "
+        "design's own)",
+    )
+    ap.add_argument(
+        "--no-restart",
+        action="store_true",
+        help="the correction only re-refines the kept design (no fresh design per iteration)",
+    )
     ap.add_argument("--engine", default="torch", help="contact solver (torch)")
     ap.add_argument("--device", default="auto", help="torch engine's device (auto)")
     ap.add_argument("--no-analytic", action="store_true", help="leave out the analytic laws")
@@ -193,8 +209,9 @@ def main() -> None:
             f"`{command}`; torch {torch.__version__}, {threads} threads, "
             f"OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', 'unset')}, engine "
             f"{rows[0]['engine']}, {args.loads} loads, correction up to "
-            f"{args.iterations} BEM solves. {len(targets)} targets designed in one call in "
-            f"{t_design:.1f} s.",
+            f"{args.iterations} BEM solves on the {args.inner} model"
+            f"{' without' if args.no_restart else ' with'} fresh designs. {len(targets)} targets "
+            f"designed in one call in {t_design:.1f} s.",
             "",
             text,
             "",

@@ -3,15 +3,22 @@ design.json block and the figure. Small grids (96^2, 4 loads) keep each solve we
 second; what the check measures at the paper's resolution is benchmarks/bench_verified.py's."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 import metainterface as mi
 from metainterface.cli import main
+from metainterface.physics.models import get_model
 from metainterface.verify import BemCheck, Verify, bem_check
 from metainterface.verify.check import curve_error
-from metainterface.verify.correct import shifted_target
+from metainterface.verify.correct import (
+    curve_fit_error,
+    fresh_design,
+    model_error,
+    shifted_target,
+)
 
 # at 96^2 the BEM reads the bilinear design ~5 % high by itself (the grid), hence max_error
 QUICK = Verify(grid=96, loads=4, correct=False, max_error=0.1)
@@ -84,6 +91,74 @@ def test_the_shifted_target_adds_the_defect():
     np.testing.assert_array_equal(p, t.p_star)
 
 
+def test_the_shifted_target_takes_the_correction_models_alpha():
+    t = mi.Target(p_star=[0.0, 1.0, 2.0, 3.0], alpha=[0.0, 0.1, 0.2, 0.3])
+    check = BemCheck(
+        p_star=np.array([1.0, 2.0]),
+        alpha_bem=np.array([0.11, 0.22]),
+        alpha_model=np.array([0.10, 0.20]),
+        alpha_target=np.array([0.1, 0.2]),
+        bem_error=0.1,
+        model_error=0.0,
+        grid=96,
+        engine="tamaas",
+        device="cpu",
+        seconds=0.0,
+    )
+    # the correction's own model reads 0.105 and 0.23 there: defect -0.005 and +0.01
+    _, a = shifted_target(t, check, 1.0, alpha_model=np.array([0.105, 0.23]))
+    np.testing.assert_allclose(a, [0.0, 0.095, 0.21, 0.31])
+
+
+def test_the_correction_runs_on_the_model_asked_for(corrected):
+    # corrected: the default, re-refined on the interacting model; "independent" and None
+    # (the design's own model, here independent) re-refine on the paper's model alike
+    s = Verify(grid=96, loads=4, correct=True, iterations=2, inner="independent")
+    paper = mi.design("bilinear", verify=s)
+    own = mi.design("bilinear", verify=replace(s, inner=None))
+    assert paper.bem.bem_error < paper.bem_before.bem_error
+    np.testing.assert_allclose(paper.design.gamma, own.design.gamma)
+    np.testing.assert_allclose(paper.design.h, own.design.h)
+    assert not np.allclose(paper.design.gamma, corrected.design.gamma)
+    # whichever model corrects, the result's model error is on the design's model
+    on_design_model = model_error(corrected.design, corrected.target, get_model(corrected.model))
+    assert corrected.error == pytest.approx(on_design_model, rel=1e-9)
+
+
+def test_each_iteration_says_where_its_design_came_from(corrected):
+    # the default also designs afresh against the shifted target; restart=False only
+    # re-refines the kept design
+    assert {c.start for c in corrected.corrections} <= {"current", "fresh"}
+    s = Verify(grid=96, loads=4, correct=True, iterations=2, restart=False)
+    r = mi.design("bilinear", verify=s)
+    assert [c.start for c in r.corrections] == ["current"] * len(r.corrections)
+    assert r.corrections[0].to_dict()["start"] == "current"
+
+
+def test_a_fresh_design_meets_a_realisable_shifted_target():
+    r = mi.design("saturating", verify=False)
+    fm = get_model("interacting")
+    curve = fm.model_curve(r.design)
+    fresh = fresh_design((curve.p_star, curve.alpha), r.design.settings, fm, seed=0)
+    assert fresh is not None
+    assert curve_fit_error(fresh, (curve.p_star, curve.alpha), fm) < 0.01
+
+
+def test_cli_correct_model_reaches_the_correction(tmp_path, capsys):
+    args = ["design", "--target", "bilinear", "--verify-grid", "96", "--verify-loads", "4"]
+    args += ["--correct", "--max-bem-error", "10"]
+    runs = {}
+    for name in ("independent", "design"):
+        assert main([*args, "--out", str(tmp_path / name), "--correct-model", name]) == 0
+        runs[name] = json.loads((tmp_path / name / "design.json").read_text())
+    capsys.readouterr()
+    a, b = (runs[n]["bem_check"] for n in ("independent", "design"))
+    assert a["alpha_bem"] == pytest.approx(b["alpha_bem"]) and "corrections" in a
+    with pytest.raises(SystemExit) as done:
+        main([*args, "--out", str(tmp_path / "x"), "--correct-model", "fem"])
+    assert done.value.code == 2 and "--correct-model" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize(
     "kwargs, name",
     [
@@ -95,6 +170,8 @@ def test_the_shifted_target_adds_the_defect():
         ({"engine": "fem"}, "engine"),
         ({"correct": "yes"}, "correct"),
         ({"device": 3}, "device"),
+        ({"inner": "fem"}, "inner"),
+        ({"restart": "yes"}, "restart"),
     ],
 )
 def test_bad_settings_give_one_line_naming_the_field(kwargs, name):

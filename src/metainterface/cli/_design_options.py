@@ -21,6 +21,7 @@ def verify(args: argparse.Namespace):
         grid=args.verify_grid,
         loads=args.verify_loads,
         correct=args.correct,
+        inner=None if args.correct_model == "design" else args.correct_model,
         max_error=args.max_bem_error / 100,
         engine=args.verify_engine,
         device=args.device,

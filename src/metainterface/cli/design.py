@@ -193,6 +193,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--no-correct", dest="correct", action="store_false", help="never correct in BEM"
     )
     check.add_argument(
+        "--correct-model",
+        choices=[*MODEL_NAMES, "design"],
+        default="interacting",
+        help="the forward model the correction re-refines on: interacting (default; its "
+        "defect to the BEM is smaller), independent, or design (the design's own --physics)",
+    )
+    check.add_argument(
         "--max-bem-error",
         type=float,
         default=2.0,
