@@ -94,3 +94,13 @@ html_theme_options = {
 html_static_path = ["_static"]
 html_css_files = ["custom.css"]
 html_show_sourcelink = False
+
+
+def _public_bases(app, name, obj, options, bases) -> None:
+    """Result classes share their coverage/idle/carrying properties through a small internal
+    mixin: the reference shows the properties on each class, not the mixin as a base."""
+    bases[:] = [b for b in bases if b.__qualname__ != "ReachCounts"]
+
+
+def setup(app) -> None:
+    app.connect("autodoc-process-bases", _public_bases)

@@ -4,6 +4,7 @@ results share."""
 
 from __future__ import annotations
 
+import functools
 import io
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -233,3 +234,34 @@ def decimate(n: int, most: int = RECORD_POINTS) -> np.ndarray:
     if n <= most:
         return np.arange(n)
     return np.unique(np.linspace(0, n - 1, most).round().astype(int))
+
+
+class ReachCounts:
+    """``coverage``, ``idle`` and ``carrying`` of a result's design (:func:`reach_counts`),
+    computed once; a result class names its forward model and reference curve in
+    ``_reach_of``."""
+
+    design: Design
+
+    def _reach_of(self) -> tuple[ForwardModel | None, tuple[np.ndarray, np.ndarray] | None]:
+        raise NotImplementedError
+
+    @functools.cached_property
+    def _reach(self) -> tuple[float, tuple[int, ...]]:
+        return reach_counts(self.design, *self._reach_of())
+
+    @property
+    def coverage(self) -> float:
+        """The fraction of the target's load range (0 to its largest P*) the design reaches."""
+        return self._reach[0]
+
+    @property
+    def idle(self) -> tuple[int, ...]:
+        """Indices of the asperities that carry no load (never touch within Delta_max, or
+        only past the target's largest load)."""
+        return self._reach[1]
+
+    @property
+    def carrying(self) -> int:
+        """The number of load-carrying asperities, N - len(idle)."""
+        return self.design.n_asperities - len(self.idle)

@@ -3,7 +3,6 @@ that draws and saves itself (design.json, curve.csv, design.png)."""
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import os
 from dataclasses import dataclass, field
@@ -27,16 +26,16 @@ if TYPE_CHECKING:
 from metainterface.designer.curves import (
     CURVE_STEPS,
     Curve,
+    ReachCounts,
     _axes,
     decimate,
     design_curve,
-    reach_counts,
     shown,
 )
 
 
 @dataclass(frozen=True, repr=False)
-class DesignResult:
+class DesignResult(ReachCounts):
     """A designed unit cell for one target.
 
     Attributes
@@ -112,21 +111,8 @@ class DesignResult:
     bem_before: BemCheck | None = None
     corrections: tuple[Correction, ...] = ()
 
-    @functools.cached_property
-    def _reach(self) -> tuple[float, tuple[int, ...]]:
-        return reach_counts(self.design, self.model, (self.target.p_star, self.target.alpha))
-
-    @property
-    def coverage(self) -> float:
-        return self._reach[0]
-
-    @property
-    def idle(self) -> tuple[int, ...]:
-        return self._reach[1]
-
-    @property
-    def carrying(self) -> int:
-        return self.design.n_asperities - len(self.idle)
+    def _reach_of(self) -> tuple[ForwardModel, tuple[np.ndarray, np.ndarray]]:
+        return self.model, (self.target.p_star, self.target.alpha)
 
     @property
     def bem_error(self) -> float | None:

@@ -9,7 +9,6 @@ within a budget (the design's heights scale with R, the printer's error does not
 
 from __future__ import annotations
 
-import functools
 import os
 import time
 from dataclasses import dataclass, field
@@ -21,7 +20,7 @@ import numpy as np
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import provenance, strict_json, write_columns, write_text
-from metainterface.designer.curves import shown
+from metainterface.designer.curves import ReachCounts, shown
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import tolerance as tol
@@ -129,7 +128,7 @@ class Settings:
 
 
 @dataclass(frozen=True, repr=False)
-class ToleranceResult:
+class ToleranceResult(ReachCounts):
     """The spread of a design's curve under manufacturing errors (numpy, float64).
 
     p_star (M,): uniform pressures on [0, P*_max] of the nominal design. alpha_nominal,
@@ -173,29 +172,9 @@ class ToleranceResult:
     printer: dict[str, Any] | None = field(default=None)
     forward_model: ForwardModel | None = None
 
-    @functools.cached_property
-    def _reach(self) -> tuple[float, tuple[int, ...]]:
-        from metainterface.designer.curves import reach_counts
-
+    def _reach_of(self) -> tuple[ForwardModel | None, tuple[np.ndarray, np.ndarray] | None]:
         ref = self.reference
-        return reach_counts(
-            self.design, self.forward_model, None if ref is None else (ref.p_star, ref.alpha)
-        )
-
-    @property
-    def coverage(self) -> float:
-        """The fraction of the reference's load range the nominal design reaches."""
-        return self._reach[0]
-
-    @property
-    def idle(self) -> tuple[int, ...]:
-        """Indices of the nominal design's asperities that carry no load."""
-        return self._reach[1]
-
-    @property
-    def carrying(self) -> int:
-        """The number of the nominal design's load-carrying asperities."""
-        return self.design.n_asperities - len(self.idle)
+        return self.forward_model, None if ref is None else (ref.p_star, ref.alpha)
 
     def band(self) -> dict[str, np.ndarray]:
         """The columns of band.csv."""
