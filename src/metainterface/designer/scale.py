@@ -133,8 +133,16 @@ def feasible_scale(
     cm^2'), ``.record()``.
     """
     law, _, given, var, span = _law_and_scale(law, shear_strength, modulus, radius, area, fit)
+    return _feasible(law, given, var, span, settings)[1]
+
+
+def _feasible(
+    law: Any, given: dict, var: str | None, span: Any, settings: CellSettings | None
+) -> tuple[dict, _scale.FeasibleScale]:
+    """The scale as given, completed where free (``_reference``), and the law's feasible
+    scale there, ``var`` searched within ``span``."""
     given = _reference(law, given, var)
-    return _scale.feasible_scale(
+    fs = _scale.feasible_scale(
         law.normal_force,
         law.friction_force,
         area=given["area"],
@@ -144,6 +152,7 @@ def feasible_scale(
         settings=settings,
         bounds=None if span is None else {var: span},
     )
+    return given, fs
 
 
 def _candidates(fs: _scale.FeasibleScale, var: str, count: int) -> np.ndarray:
@@ -239,18 +248,8 @@ def design_scale(
         )
     if not isinstance(candidates, int) or not 1 <= candidates <= 32:
         raise MetainterfaceError(f"candidates must be an integer in [1, 32], got {candidates!r}")
-    given = _reference(law, given, var)
     s = settings or CellSettings()
-    fs = _scale.feasible_scale(
-        law.normal_force,
-        law.friction_force,
-        area=given["area"],
-        modulus=given["modulus"],
-        shear_strength=given["shear_strength"],
-        radius=given["radius"],
-        settings=s,
-        bounds=None if span is None else {var: span},
-    )
+    given, fs = _feasible(law, given, var, span, s)
     values = _candidates(fs, var, candidates)
     stem = name or (os.path.splitext(os.path.basename(source))[0] or "friction")
 
