@@ -22,7 +22,27 @@ DEFAULTS = {
 }
 
 
+# TrainConfig.laws()'s, for the options --laws changes (a test checks them too).
+LAWS = {
+    "epochs": 60,
+    "batch_size": 512,
+    "lr": 5e-4,
+    "curriculum_epochs": 0,
+    "w_shape": 0.0,
+    "w_grad": 0.0,
+    "w_mag": 0.0,
+    "w_curve": 100.0,
+}
+
 PAPER = {"shape": 10, "grad": 1, "mag": 10, "curve": 0}
+
+
+def _default(name: str, fmt: str = "{}") -> str:
+    """'default X' for an option, with the --laws value where that differs."""
+    text = "default " + fmt.format(DEFAULTS[name])
+    if name in LAWS:
+        text += ", with --laws " + fmt.format(LAWS[name])
+    return text
 
 
 def gap_scale(text: str) -> float | None:
@@ -50,20 +70,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--dataset", help="dataset .npz from `metainterface generate`")
     p.add_argument("--out", help="run folder")
-    p.add_argument("--epochs", type=positive_int, default=DEFAULTS["epochs"])
+    p.add_argument("--epochs", type=positive_int, help=_default("epochs"))
     p.add_argument(
         "--batch-size",
         type=positive_int,
-        default=DEFAULTS["batch_size"],
         help="goes with --lr: 1024 with 2e-3 by default (the shipped model: 512 with "
-        "2e-3); a GPU wants larger batches, and then a larger --lr",
+        "2e-3; with --laws 512 with 5e-4); a GPU wants larger batches, and then a larger --lr",
     )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(
         "--lr",
         type=float,
-        default=DEFAULTS["lr"],
-        help="peak learning rate (AdamW), see --batch-size",
+        help=f"peak learning rate (AdamW, {_default('lr')}), see --batch-size",
     )
     p.add_argument(
         "--patience",
@@ -74,8 +92,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--curriculum-epochs",
         type=int,
-        default=DEFAULTS["curriculum_epochs"],
-        help="epochs over which the parameter anchor lambda falls linearly to 0",
+        help="epochs over which the parameter anchor lambda falls linearly to 0 "
+        f"({_default('curriculum_epochs')})",
     )
     p.add_argument(
         "--max-gap",
@@ -93,9 +111,24 @@ def register(sub: argparse._SubParsersAction) -> None:
         p.add_argument(
             f"--w-{name}",
             type=float,
-            default=DEFAULTS[f"w_{name}"],
-            help=f"loss weight of the {what} (default %(default)s; the paper's: {PAPER[name]})",
+            help=f"loss weight of the {what} ({_default('w_' + name)}; the paper's: "
+            f"{PAPER[name]})",
         )
+    p.add_argument(
+        "--laws",
+        action="store_true",
+        help="train the friction-law network: on targets made from the dataset's cells the "
+        "way friction laws arrive (ended anywhere, a few points, no stiffness, near but not "
+        "on a cell's curve), loss the curve error at their own pressures, starting from "
+        "--init (default: the shipped surrogate); `design` reads targets without stiffness "
+        "with it too when it is the shipped weights/surrogate_laws.pt",
+    )
+    p.add_argument(
+        "--init",
+        metavar="MODEL",
+        help="start from this model file's weights (with --laws: the shipped surrogate "
+        "unless given)",
+    )
     p.add_argument("--resume", action="store_true", help="continue the run in --out")
     add_device(p)
     p.add_argument("--plot", metavar="RUN_DIR", help="draw the training panels of a run")
@@ -120,19 +153,16 @@ def run(args: argparse.Namespace) -> int:
         raise MetainterfaceError("train needs --dataset FILE and --out RUN_DIR (or --plot RUN_DIR)")
     import metainterface as mi
 
-    config = mi.TrainConfig(
-        epochs=args.epochs,
-        batch_size=args.batch_size,
-        seed=args.seed,
-        lr=args.lr,
-        patience=args.patience,
-        curriculum_epochs=args.curriculum_epochs,
-        max_gap=args.max_gap,
-        w_shape=args.w_shape,
-        w_grad=args.w_grad,
-        w_mag=args.w_mag,
-        w_curve=args.w_curve,
-    )
+    given = {
+        k: getattr(args, k)
+        for k in ("epochs", "batch_size", "lr", "curriculum_epochs", *(f"w_{w}" for w in PAPER))
+        if getattr(args, k) is not None
+    }
+    given.update(seed=args.seed, patience=args.patience, max_gap=args.max_gap)
+    if args.init is not None:
+        given["init"] = args.init
+    make = mi.TrainConfig.laws if args.laws else mi.TrainConfig
+    config = make(**{**({} if args.laws else DEFAULTS), **given})
     result = mi.train_surrogate(
         args.dataset, args.out, config, resume=args.resume, device=args.device
     )

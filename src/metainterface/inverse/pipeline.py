@@ -40,7 +40,13 @@ from metainterface.inverse.refine import (
     relative_error,
     robust_error,
 )
-from metainterface.inverse.starts import best_views, hedge_starts, predict, random_starts
+from metainterface.inverse.starts import (
+    best_views,
+    hedge_starts,
+    predict,
+    random_starts,
+    shipped_laws_net,
+)
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.models import ForwardModel, get_model
@@ -265,8 +271,9 @@ def _design(
         net, model_settings, _ = load_model(model_path or default_model_path())
         settings = model_settings
         gamma0, h0 = predict(net, targets, settings)
+        laws_net = shipped_laws_net(model_path, settings, targets)
         gamma0, h0 = best_views(
-            net, targets, gamma0, h0, settings, model, refine_settings.grid_points
+            net, targets, gamma0, h0, settings, model, refine_settings.grid_points, laws_net
         )
         per_target = 1 + max(hedge, 0)
         if hedge > 0:  # rows per target: [zero-shot, hedge starts]

@@ -4,7 +4,9 @@ the prediction itself (with views of a target that ends without stiffness)."""
 from __future__ import annotations
 
 import copy
+import os
 from collections.abc import Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -136,20 +138,29 @@ def best_views(
     settings: CellSettings,
     model: ForwardModel,
     points: int,
+    laws_net: InverseMLP | None = None,
 ) -> tuple[Tensor, Tensor]:
-    """The zero-shot designs (T, N), each target without stiffness given the best of its
-    own prediction and those of its views (:func:`target_views`), by the error on the
-    target itself."""
+    """The zero-shot designs (T, N), each target without stiffness given the best, by the
+    error on the target itself, of its own prediction (gamma0, h0), those of its views
+    (:func:`target_views`), and, with ``laws_net`` (the network trained on targets made the
+    way friction laws arrive), that network's on the target and its views."""
     gamma0, h0 = gamma0.clone(), h0.clone()
     for i, t in enumerate(targets):
         if t.stiffness is not None:
             continue
         views = target_views(t)
-        if not views:
+        g_c, h_c = [gamma0[i : i + 1]], [h0[i : i + 1]]
+        if views:
+            g_v, h_v = predict(net, views, settings)
+            g_c.append(g_v)
+            h_c.append(h_v)
+        if laws_net is not None:
+            g_l, h_l = predict(laws_net, [t, *views], settings)
+            g_c.append(g_l)
+            h_c.append(h_l)
+        if len(g_c) == 1:
             continue
-        g_v, h_v = predict(net, views, settings)
-        g = torch.cat([gamma0[i : i + 1], g_v])
-        h = torch.cat([h0[i : i + 1], h_v])
+        g, h = torch.cat(g_c), torch.cat(h_c)
         grid = TargetGrid.from_curves([(t.p_star, t.alpha)], points)
         err = relative_error(
             g, h, settings, grid.rows(torch.zeros(g.shape[0], dtype=torch.long)), model
@@ -157,6 +168,26 @@ def best_views(
         k = int(err.argmin())
         gamma0[i], h0[i] = g[k], h[k]
     return gamma0, h0
+
+
+def shipped_laws_net(
+    model_path: str | os.PathLike[str] | None, settings: CellSettings, targets: Sequence[Target]
+) -> InverseMLP | None:
+    """The shipped friction-law network, where the shipped surrogate designs targets without
+    stiffness and the network is there (and made for the same cell); else None. A surrogate
+    of the user's own is used alone: the shipped laws network was fine-tuned from ours."""
+    from metainterface.surrogate.checkpoint import (
+        default_laws_model_path,
+        default_model_path,
+        load_model,
+    )
+
+    shipped = model_path is None or Path(model_path).resolve() == default_model_path().resolve()
+    path = default_laws_model_path()
+    if not shipped or not path.is_file() or all(t.stiffness is not None for t in targets):
+        return None
+    net, trained, _ = load_model(path)
+    return net if trained == settings else None
 
 
 #: Training-set spread below which an input counts as constant (alpha_hat at both ends,

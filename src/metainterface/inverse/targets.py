@@ -29,7 +29,12 @@ import torch
 from metainterface._files.columns import read_columns
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import sweep
+from metainterface.physics.curves import (
+    S_HAT_MAX,
+    features_from_normalised,
+    normalised_from_points,
+    sweep,
+)
 from metainterface.physics.pressures import at_pressures
 
 
@@ -313,21 +318,26 @@ def target_grid(target: Target, n: int = 128) -> tuple[np.ndarray, np.ndarray]:
     return grid, np.interp(grid, target.p_star, target.alpha, left=0.0)
 
 
-def target_features(target: Target, n_steps: int = 128, s_hat_max: float = 20.0) -> torch.Tensor:
+def target_features(
+    target: Target, n_steps: int = 128, s_hat_max: float = S_HAT_MAX
+) -> torch.Tensor:
     """The surrogate's input (2 n_steps + 2,) for a target: alpha_hat, S_hat, log10 scalars.
 
     S* comes from the target's own stiffness where it has one, else from finite differences
-    of alpha(P*); S_hat is clipped to [0, s_hat_max] (steep targets have unbounded S_hat).
+    of alpha(P*) (:func:`~metainterface.physics.curves.normalised_from_points`, the estimate
+    the friction-law network was trained on); S_hat is clipped to [0, s_hat_max] (steep
+    targets have unbounded S_hat).
     """
-    grid, alpha = target_grid(target, n_steps)
-    a_max, p_max = float(alpha[-1]), target.p_star_max
+    p, a = target.p_star, target.alpha
+    if p[0] > 0:  # the curve starts at the origin, as every contact curve does
+        p, a = np.concatenate([[0.0], p]), np.concatenate([[0.0], a])
+    p64 = torch.as_tensor(p, dtype=torch.float64)[None]
+    a64 = torch.as_tensor(a, dtype=torch.float64)[None]
+    alpha_hat, s_hat, p_max, a_max = normalised_from_points(p64, a64, n_steps, s_hat_max)
     if target.stiffness is not None:
+        grid = np.linspace(0.0, target.p_star_max, n_steps)
         stiff = np.interp(grid, target.p_star, target.stiffness)
-    else:
-        slope = np.gradient(alpha, grid)
-        stiff = np.where(slope > 0, 1.0 / np.maximum(slope, 1e-300), 0.0)
-    s_hat = np.clip(stiff * a_max / p_max, 0.0, s_hat_max)
-    return torch.as_tensor(
-        np.concatenate([alpha / a_max, s_hat, [np.log10(p_max), np.log10(a_max)]]),
-        dtype=torch.float32,
-    )
+        s_hat = torch.as_tensor(np.clip(stiff * float(a_max[0]) / float(p_max[0]), 0.0, s_hat_max))[
+            None
+        ]
+    return features_from_normalised(alpha_hat, s_hat, p_max, a_max)[0].to(torch.float32)

@@ -88,6 +88,42 @@ def features_from_normalised(
     return torch.cat([alpha_hat, stiffness_hat, scalars], dim=-1)
 
 
+#: Largest S_hat a curve given by its points is read with (steep curves have unbounded ones).
+S_HAT_MAX = 20.0
+
+
+def normalised_from_points(
+    p_star: Tensor, alpha: Tensor, n_steps: int, s_hat_max: float = S_HAT_MAX
+) -> tuple[Tensor, Tensor, Tensor, Tensor]:
+    """A curve known only by its points, normalised as the surrogate reads it.
+
+    p_star, alpha: (B, M) increasing pressures from 0 and their contact fractions (a target
+    without a stiffness column, e.g. a friction law). The points are joined linearly onto
+    n_steps uniform pressures over [0, P*_max]; S* = 1 / (dalpha/dP*) by central differences
+    there (one-sided at the ends, 0 where alpha does not rise), clipped to s_hat_max once
+    normalised. One function for training on such curves and for reading them in use, so the
+    network sees the same estimate in both.
+    Returns alpha_hat, S_hat (B, n_steps); P*_max, alpha_max (B,).
+    """
+    p_max = p_star[:, -1]
+    grid = torch.linspace(0, 1, n_steps, dtype=p_star.dtype, device=p_star.device)
+    grid = grid[None] * p_max[:, None]
+    a = interp(grid, p_star, alpha)
+    a_max = a[:, -1]
+    slope = torch.gradient(a, dim=-1)[0] * ((n_steps - 1) / p_max)[:, None]
+    stiff = torch.where(slope > 0, 1.0 / slope.clamp_min(1e-300), 0.0)
+    s_hat = (stiff * (a_max / p_max)[:, None]).clamp(0.0, s_hat_max)
+    return a / a_max[:, None], s_hat, p_max, a_max
+
+
+def features_from_points(
+    p_star: Tensor, alpha: Tensor, n_steps: int, s_hat_max: float = S_HAT_MAX
+) -> Tensor:
+    """(B, 2 n_steps + 2) surrogate input of curves given by their points (B, M): see
+    :func:`normalised_from_points`."""
+    return features_from_normalised(*normalised_from_points(p_star, alpha, n_steps, s_hat_max))
+
+
 def _contact_floor(dtype: torch.dtype) -> float:
     return math.sqrt(torch.finfo(dtype).tiny)
 

@@ -8,6 +8,8 @@ import os
 from pathlib import Path
 from typing import Any
 
+import torch
+
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_file, check_output_folder
@@ -18,6 +20,7 @@ from metainterface.physics.cell import CellSettings
 from metainterface.surrogate.checkpoint import default_model_path, load_model
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.evaluate import evaluate
+from metainterface.surrogate.laws import law_split
 from metainterface.surrogate.loss import weights_of
 from metainterface.surrogate.train import TrainConfig, TrainResult, train
 
@@ -65,16 +68,26 @@ def train_surrogate(
 ) -> TrainResult:
     """Train the inverse network on a dataset (``generate_dataset``) into the run folder
     ``out``: one atomic checkpoint per epoch (``resume=True`` continues), the best model as
-    ``out/model.pt``, usable as ``design(..., surrogate=out / "model.pt")``. ``device``
+    ``out/model.pt``, usable as ``design(..., surrogate=out / "model.pt")``. With
+    ``config.reads == "laws"`` it trains on targets made from the dataset's cells the way
+    friction laws arrive (``metainterface.surrogate.laws``), usually from ``config.init``,
+    the shipped network (``TrainConfig.laws()``). ``device``
     ("auto", "cpu", "cuda", "cuda:N") is where the model and the dataset live while it
     trains; the files load on any device (a run may be resumed on another one)."""
     dev = resolve_device(device)
     check_output_folder(out)
     ds = load_dataset(dataset)
     fingerprint = hashlib.sha256(json.dumps(ds.meta, sort_keys=True).encode()).hexdigest()[:16]
+    config = config or TrainConfig()
+    train_split, val_split = split_of(ds, "train"), split_of(ds, "val")
+    if config.reads == "laws":
+        with torch.inference_mode():
+            # the validation targets get their own seed: other cuts of other cells
+            train_split = law_split(train_split, ds.settings, config.seed)
+            val_split = law_split(val_split, ds.settings, config.seed + 1)
     return train(
-        split_of(ds, "train"),
-        split_of(ds, "val"),
+        train_split,
+        val_split,
         ds.settings,
         out,
         config,

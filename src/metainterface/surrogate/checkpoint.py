@@ -84,3 +84,10 @@ def load_model(path: str | os.PathLike[str]) -> tuple[InverseMLP, CellSettings, 
 def default_model_path() -> Path:
     """The surrogate shipped with the package."""
     return Path(__file__).resolve().parents[1] / "weights" / "surrogate.pt"
+
+
+def default_laws_model_path() -> Path:
+    """The shipped friction-law network: the shipped surrogate fine-tuned on targets made the
+    way friction laws arrive (``metainterface.surrogate.laws``); `design` also reads targets
+    without stiffness with it when it uses the shipped surrogate."""
+    return default_model_path().with_name("surrogate_laws.pt")

@@ -35,11 +35,38 @@ from metainterface._files.provenance import provenance
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import curve
-from metainterface.surrogate.checkpoint import load_torch, save_model, save_torch
+from metainterface.surrogate.checkpoint import load_model, load_torch, save_model, save_torch
 from metainterface.surrogate.data import Split
-from metainterface.surrogate.loss import PAPER_WEIGHTS, LossWeights, param_loss, physics_loss
+from metainterface.surrogate.loss import (
+    PAPER_WEIGHTS,
+    CurveTargets,
+    LossWeights,
+    law_error,
+    param_loss,
+    physics_loss,
+)
 from metainterface.surrogate.model import MAX_GAP, InverseMLP
 from metainterface.surrogate.schedules import Schedules
+
+#: What a network can be trained to read (TrainConfig.reads).
+READS = ("curves", "laws")
+
+#: The settings that make the friction-law network: curve error only (warped and shaped
+#: targets have no known design, so no parameter anchor), a sharp contact law from the
+#: start (the network it starts from is trained), a lower learning rate.
+LAWS_PRESET = {
+    "reads": "laws",
+    "epochs": 60,
+    "batch_size": 512,
+    "lr": 5e-4,
+    "curriculum_epochs": 0,
+    "lambda_start": 0.0,
+    "kappa_start": 1e5,
+    "w_shape": 0.0,
+    "w_grad": 0.0,
+    "w_mag": 0.0,
+    "w_curve": 100.0,
+}
 
 METRICS = ("epoch", "train_loss", "val_loss", "kappa", "lambda", "lr", "seconds")
 
@@ -78,6 +105,15 @@ class TrainConfig:
         The weight of the relative curve error, the figure ``evaluate`` reports (not in the
         paper: 0 there). It trains shape and magnitude together where they matter for
         alpha(P*) (MODEL_CARD.md has the ablation).
+    reads : str
+        What the network learns to read: ``"curves"``, the dataset's exact curves with their
+        stiffness (the shipped surrogate), or ``"laws"``, targets made from the dataset's
+        cells the way friction laws arrive (``metainterface.surrogate.laws``: ended
+        anywhere, a few points, no stiffness, near but not on a cell's curve).
+    init : str or None
+        A model file to start from (its weights; the input standardisation is refitted to
+        this run's inputs with the first layer compensated, so the start predicts as the
+        file does). None: random weights.
     """
 
     epochs: int = 500
@@ -97,8 +133,12 @@ class TrainConfig:
     w_grad: float = 1.0
     w_mag: float = 1000.0
     w_curve: float = 300.0
+    reads: str = "curves"
+    init: str | None = None
 
     def __post_init__(self) -> None:
+        if self.reads not in READS:
+            raise MetainterfaceError(f"reads must be one of {', '.join(READS)}, got {self.reads!r}")
         big = 1_000_000  # epochs, batches, steps: beyond this a run would not end
         for name, low, high in (
             ("epochs", 1, big),
@@ -123,6 +163,14 @@ class TrainConfig:
                 "the loss weights w_shape, w_grad, w_mag and w_curve (--w-*) are all 0: "
                 "nothing would be learned; make at least one > 0"
             )
+
+    @classmethod
+    def laws(cls, **changes: Any) -> TrainConfig:
+        """The settings that made the shipped friction-law network (:data:`LAWS_PRESET`,
+        starting from the shipped surrogate), with ``changes``."""
+        from metainterface.surrogate.checkpoint import default_model_path
+
+        return cls(**{**LAWS_PRESET, "init": str(default_model_path()), **changes})
 
     @property
     def weights(self) -> LossWeights:
@@ -160,9 +208,10 @@ def evaluate_loss(
     settings: CellSettings,
     weights: LossWeights = PAPER_WEIGHTS,
     chunk: int = 4096,
+    reads: str = "curves",
 ) -> float:
     """Mean exact-physics loss of the model on a split (no gradients, eval mode), on the
-    split's device (the model must be there too)."""
+    split's device (the model must be there too); ``reads`` as in :class:`TrainConfig`."""
     model.eval()
     total = 0.0
     with torch.no_grad():
@@ -170,8 +219,29 @@ def evaluate_loss(
             idx = torch.arange(lo, min(lo + chunk, len(split)), device=split.features.device)
             feats, targets, _, _ = split.rows(idx)
             gamma, h = model.design(feats, settings)
-            total += float(physics_loss(curve(gamma, h, settings), targets, weights)) * len(idx)
+            total += float(batch_loss(gamma, h, targets, settings, weights, reads)) * len(idx)
     return total / len(split)
+
+
+def batch_loss(
+    gamma: torch.Tensor,
+    h: torch.Tensor,
+    targets: CurveTargets,
+    settings: CellSettings,
+    weights: LossWeights,
+    reads: str = "curves",
+    smooth: float | None = None,
+    n_delta: int | None = None,
+) -> torch.Tensor:
+    """The training loss of predicted (B, N) designs (a scalar). Curves: the composite loss
+    on the design's curve (``smooth``: the softplus steepness kappa_s, None for the exact
+    law; ``n_delta`` Delta samples). Laws: ``weights.curve`` times the mean
+    :func:`~metainterface.surrogate.loss.law_error`, exact law at the target's pressures
+    (a target that ends early is seen at full resolution)."""
+    if reads == "laws":
+        return weights.curve * law_error(gamma, h, targets, settings).mean()
+    pred = curve(gamma, h, settings, smooth=smooth, n_delta=n_delta)
+    return physics_loss(pred, targets, weights)
 
 
 def _check_sizes(train: Split, val: Split, batch_size: int) -> None:
@@ -211,7 +281,10 @@ def train(
     ckpt_path = out / "checkpoint.pt"
     torch.manual_seed(config.seed)
     model = InverseMLP(settings.n_asperities, settings.n_steps, config.max_gap).to(dev)
-    model.set_input_scaling(train_split.features)
+    if config.init is not None and not resume:
+        _start_from(model, config.init, settings, train_split.features)
+    else:
+        model.set_input_scaling(train_split.features)
     # fused: one kernel for all parameters, half the optimiser time of the foreach default
     opt = torch.optim.AdamW(
         model.parameters(), lr=config.lr, weight_decay=config.weight_decay, fused=True
@@ -281,8 +354,16 @@ def train(
         for lo in range(0, n - config.batch_size + 1, config.batch_size):
             feats, targets, g_t, h_t = train_split.rows(order[lo : lo + config.batch_size])
             gamma, h = model.design(feats, settings)
-            pred = curve(gamma, h, settings, smooth=kappa, n_delta=config.physics_steps)
-            loss = physics_loss(pred, targets, config.weights)
+            loss = batch_loss(
+                gamma,
+                h,
+                targets,
+                settings,
+                config.weights,
+                config.reads,
+                kappa,
+                config.physics_steps,
+            )
             if lam > 0:
                 loss = loss + lam * param_loss(gamma, h, g_t, h_t, settings)
             opt.zero_grad(set_to_none=True)
@@ -293,7 +374,7 @@ def train(
         run_loss = float(epoch_loss)
         lr = opt.param_groups[0]["lr"]
         sched.step()
-        val = evaluate_loss(model, val_split, settings, config.weights)
+        val = evaluate_loss(model, val_split, settings, config.weights, reads=config.reads)
         if not math.isfinite(val):
             raise MetainterfaceError(
                 f"training diverged at epoch {epoch + 1} (validation loss {val})"
@@ -345,6 +426,30 @@ def train(
             break
     bar.close()
     return TrainResult(out, len(history), best_epoch, best, stopped, time.perf_counter() - t_run)
+
+
+def _start_from(model: InverseMLP, path: str, settings: CellSettings, features) -> None:
+    """Load a model file's weights into ``model`` and refit the input standardisation to
+    ``features``, folding the change into the first layer so the network computes what the
+    file's did. Inputs that were constant where the file was trained (spread < 1e-4) carried
+    nothing; their weights start at 0."""
+    src, trained, _ = load_model(path)
+    if trained != settings:
+        raise MetainterfaceError(f"init model {path}: trained for another cell than the dataset's")
+    if src.max_gap != model.max_gap:
+        raise MetainterfaceError(
+            f"init model {path}: max_gap {src.max_gap} differs from this run's {model.max_gap}"
+        )
+    with torch.no_grad():
+        model.load_state_dict(src.state_dict())
+        old_mean, old_std = model.in_mean.clone(), model.in_std.clone()
+        model.set_input_scaling(features)
+        live = old_std >= 1e-4
+        scale = torch.where(live, model.in_std / old_std, 0.0)
+        shift = torch.where(live, (model.in_mean - old_mean) / old_std, 0.0)
+        first = model.net[0]
+        first.bias += first.weight @ shift
+        first.weight *= scale[None]
 
 
 def _same_dataset(ckpt_path: Path, stored: dict | None, given: dict | None) -> None:
