@@ -158,6 +158,7 @@ def main() -> None:
         "median / p90 |",
         "| --- | ---: | ---: | ---: |",
     ]
+    idle_lines: list[str] = []
     for name, key, sub in rows:
         cells_txt = []
         for which in ("before", "after"):
@@ -168,17 +169,20 @@ def main() -> None:
             cells_txt.append(f"{med:.3g} % / {p90:.3g} %")
         lines.append(f"| {name} | {e.size} | {cells_txt[0]} | {cells_txt[1]} |")
     if args.refine:
-        made = mi.design(targets, verify=False)
-        refined = np.array([r.error for r in made])
-        counts = [idle_count(r) for r in made]
-        lines.append(
-            f"| friction laws, refined (CLI defaults) | {refined.size} | | "
-            f"{100 * np.median(refined):.3g} % / {100 * np.quantile(refined, 0.9):.3g} % |"
-        )
-        lines.append(
-            f"\n{sum(c > 0 for c in counts)} of {refined.size} refined designs have an asperity "
-            f"that never touches over the law's range ({sum(counts)} such asperities in all)"
-        )
+        for name, group in (("friction laws", targets), ("held-out families", held)):
+            made = mi.design(group, verify=False)
+            refined = np.array([r.error for r in made])
+            counts = [idle_count(r) for r in made]
+            lines.append(
+                f"| {name}, refined (CLI defaults) | {refined.size} | | "
+                f"{100 * np.median(refined):.3g} % / {100 * np.quantile(refined, 0.9):.3g} % |"
+            )
+            idle_lines.append(
+                f"{sum(c > 0 for c in counts)} of {refined.size} refined designs of the {name} "
+                f"have an asperity that never touches over the law's range ({sum(counts)} such "
+                "asperities in all)"
+            )
+    lines += ["", *idle_lines] if idle_lines else []
     text = "\n".join(lines)
     print(text)
     print(f"{infeasible + held_bad} of {args.laws + args.held_out} laws had no feasible scale")

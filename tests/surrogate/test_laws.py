@@ -82,17 +82,25 @@ def test_law_targets_are_cut_curves_of_the_cells(cells):
         mi.TrainConfig(reads="pictures")
 
 
-def test_training_the_law_network_from_the_cli(cells, tmp_path):
+def test_training_the_law_network_from_the_cli(cells, tmp_path, capsys):
     path, _ = cells
     run = tmp_path / "run"
     args = ["train", "--dataset", str(path), "--laws", "--epochs", "2", "--out", str(run)]
     assert main([*args, "--batch-size", "64"]) == 0
-    net, settings, config = load_model(run / "model.pt")
+    _, settings, config = load_model(run / "model.pt")
     assert settings == S and config["train"]["reads"] == "laws"
     assert config["train"]["init"] == str(default_model_path())
     assert config["train"]["w_shape"] == 0 and config["train"]["w_curve"] == 100
-    assert main(["train", "--dataset", str(path), "--laws", "--init", str(tmp_path / "no.pt"),
-                 "--out", str(tmp_path / "r2")]) == 2
+    capsys.readouterr()
+    assert main(["evaluate", "--model", str(run / "model.pt"), "--dataset", str(path)]) == 0
+    table = capsys.readouterr().out
+    assert all(f"| {kind} |" in table for kind in KINDS) and "n/a" in table
+    plot = ["--plot", str(tmp_path / "f.png")]
+    assert main(["evaluate", "--model", str(run / "model.pt"), "--dataset", str(path), *plot]) == 2
+    assert "friction-law network" in capsys.readouterr().err
+    bad = ["train", "--dataset", str(path), "--laws", "--init", str(tmp_path / "no.pt")]
+    assert main([*bad, "--out", str(tmp_path / "r2")]) == 2
+    assert "no.pt: file not found" in capsys.readouterr().err
 
 
 def _law_targets():
@@ -114,8 +122,12 @@ def _law_targets():
         var = next(v for v in at if fs.ranges[v])  # each is reachable at some scale
         at[var] = fs.best[var]
         t = friction_target(
-            law, shear_strength=at["shear_strength"], e_star=at["modulus"], radius=RADIUS,
-            area=at["area"], fit="never",
+            law,
+            shear_strength=at["shear_strength"],
+            e_star=at["modulus"],
+            radius=RADIUS,
+            area=at["area"],
+            fit="never",
         )
         out.append(mi.Target(p_star=t.p_star, alpha=t.alpha, name=name))
     return out
@@ -132,8 +144,9 @@ def test_design_reads_friction_laws_with_the_law_network(tmp_path):
     assert (after <= before + 1e-12).all()
     assert np.median(after) < 0.05 and np.median(after) < 0.5 * np.median(before)
     # a target with its stiffness is read by the shipped surrogate alone, as before
-    with_s = mi.Target(p_star=targets[0].p_star, alpha=targets[0].alpha,
-                       stiffness=np.ones_like(targets[0].p_star))
+    with_s = mi.Target(
+        p_star=targets[0].p_star, alpha=targets[0].alpha, stiffness=np.ones_like(targets[0].p_star)
+    )
     a = mi.design(with_s, surrogate=alone, **quick)
     b = mi.design(with_s, **quick)
     np.testing.assert_array_equal(a.design.gamma, b.design.gamma)

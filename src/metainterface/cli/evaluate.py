@@ -10,7 +10,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "evaluate",
         help="per-category zero-shot errors of a surrogate on the test split",
         description="Median and 90th-percentile relative curve error per category, log10 "
-        "errors of P*_max and alpha_max, and the train/test loss gap.",
+        "errors of P*_max and alpha_max, and the train/test loss gap. A friction-law network "
+        "(`train --laws`) is evaluated on friction-law-like targets made from the test "
+        "cells, per kind (cut, warped, shaped).",
     )
     p.add_argument("--model", help="model file (default: the shipped surrogate)")
     p.add_argument("--dataset", required=True, help="dataset .npz from `metainterface generate`")
@@ -37,6 +39,13 @@ def run(args: argparse.Namespace) -> int:
             "provenance": provenance(command="evaluate"),
         }
         write_text(args.out, strict_json.dumps(record, indent=2) + "\n")
+    if args.plot is not None and result["reads"] == "laws":
+        from metainterface.errors import MetainterfaceError
+
+        raise MetainterfaceError(
+            "--plot draws the test split's exact curves; a friction-law network reads other "
+            "targets (`design --friction-csv LAW --out DIR` draws its fit in DIR/design.png)"
+        )
     if args.plot is not None:
         from metainterface.data import load_dataset
         from metainterface.plots import plot_reconstructions, save_figure

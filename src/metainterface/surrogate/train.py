@@ -166,7 +166,7 @@ class TrainConfig:
 
     @classmethod
     def laws(cls, **changes: Any) -> TrainConfig:
-        """The settings that made the shipped friction-law network (:data:`LAWS_PRESET`,
+        """The settings that made the shipped friction-law network (``LAWS_PRESET``,
         starting from the shipped surrogate), with ``changes``."""
         from metainterface.surrogate.checkpoint import default_model_path
 
