@@ -31,6 +31,8 @@ from metainterface.runtime import tune_allocator
 
 def realisable_targets(count: int, seed: int = 7) -> list[Target]:
     """Exact curves of random cells (gamma uniform in the bounds, h uniform in [0, Delta_max])."""
+    if count == 0:
+        return []
     s = CellSettings()
     gen = torch.Generator().manual_seed(seed)
     g = s.gamma_min + (s.gamma_max - s.gamma_min) * torch.rand(
