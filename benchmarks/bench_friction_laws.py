@@ -79,12 +79,8 @@ def law_targets(
         fs = mi.feasible_scale(
             law, shear_strength=TAU, modulus=E_STAR, radius=RADIUS, area=AREA, fit="never"
         )
-        at = {"area": AREA, "modulus": E_STAR, "shear_strength": TAU}
-        var = next((v for v in ("area", "modulus", "shear_strength") if fs.ranges[v]), None)
-        if var is None:
-            infeasible += 1
-            var = min(fs.best, key=lambda v: fs.best_outside[v])
-        at[var] = fs.best[var]
+        infeasible += not any(fs.ranges.values())
+        at = fs.suggest()
         ft = friction_target(
             law,
             shear_strength=at["shear_strength"],

@@ -44,6 +44,9 @@ def test_the_true_area_is_in_the_feasible_range(law_csv):
     assert at_true.reachable
     rec = fs.record()
     assert rec["ranges"]["area"] and rec["given"]["area"] == pytest.approx(2e-4)
+    at = fs.suggest()  # the area moved into its range, the rest as given
+    assert any(lo <= at["area"] <= hi for lo, hi in spans)
+    assert at["modulus"] == 2e6 and at["shear_strength"] == 0.25e6 and at["radius"] == 0.5e-3
 
 
 def test_unreachable_by_area_alone_names_another_variable(tmp_path):
@@ -56,6 +59,8 @@ def test_unreachable_by_area_alone_names_another_variable(tmp_path):
         path, shear_strength="0.25MPa", modulus="2MPa", radius="0.5mm", area="4cm2"
     )
     assert fs.ranges["area"] == [] and fs.ranges["modulus"]
+    at = fs.suggest()  # no area does it: the modulus moves instead
+    assert at["area"] == pytest.approx(4e-4) and at["modulus"] == fs.best["modulus"] != 2e6
     assert "E* of" in fs.summary()[1] and "MPa" in fs.summary()[1]
 
 

@@ -119,9 +119,8 @@ def _law_targets():
         fs = mi.feasible_scale(
             law, shear_strength=TAU, modulus=E_STAR, radius=RADIUS, area=AREA, fit="never"
         )
-        at = {"area": AREA, "modulus": E_STAR, "shear_strength": TAU}
-        var = next(v for v in at if fs.ranges[v])  # each is reachable at some scale
-        at[var] = fs.best[var]
+        at = fs.suggest()
+        assert any(fs.ranges.values()), name  # reachable at some scale
         t = friction_target(
             law,
             shear_strength=at["shear_strength"],

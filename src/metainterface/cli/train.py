@@ -111,8 +111,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         p.add_argument(
             f"--w-{name}",
             type=float,
-            help=f"loss weight of the {what} ({_default('w_' + name)}; the paper's: "
-            f"{PAPER[name]})",
+            help=f"loss weight of the {what} ({_default('w_' + name)}; the paper's: {PAPER[name]})",
         )
     p.add_argument(
         "--laws",

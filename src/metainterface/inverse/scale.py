@@ -88,6 +88,16 @@ class FeasibleScale:
         """Whether the law is reachable at the given scale."""
         return self.outside == 0
 
+    def suggest(self) -> dict[str, float]:
+        """A scale to design the law at, SI ({'area', 'modulus', 'shear_strength',
+        'radius'}): the given one with the first of area, modulus, shear strength that has a
+        feasible range set to its best value there; where none has, the one that leaves the
+        fewest points outside set to its closest value."""
+        var = next((v for v in ("area", "modulus", "shear_strength") if self.ranges[v]), None)
+        if var is None:
+            var = min(self.best, key=lambda v: self.best_outside[v])
+        return {**self.given, var: self.best[var]}
+
     def tiles(self, area: float) -> tuple[float, int]:
         """(cells, cells per side) that tile a nominal area [m^2]."""
         n = area / self.cell_area
