@@ -66,18 +66,31 @@ def make_law(family: str, rng: np.random.Generator) -> tuple[np.ndarray, np.ndar
     return fn, ff
 
 
+#: Measured laws: rows kept of the 40, and the relative scatter of their friction.
+MEASURED_ROWS, SCATTER = 8, 0.03
+
+
 def law_targets(
-    count: int, seed: int, families: tuple[str, ...] = FAMILIES
+    count: int, seed: int, families: tuple[str, ...] = FAMILIES, measured: bool = False
 ) -> tuple[list[mi.Target], list[str], int]:
-    """Targets of ``count`` laws (families in turn) at a feasible scale, no stiffness."""
+    """Targets of ``count`` laws (families in turn) at a feasible scale, no stiffness.
+    ``measured``: the same laws as measured, MEASURED_ROWS random rows of the 40 with a
+    normal scatter of SCATTER in friction, fitted as `design` fits them (``fit="auto"``)."""
     rng = np.random.default_rng(seed)
+    noise = np.random.default_rng(seed + 100)  # apart, so the laws are the clean ones
     out, fams, infeasible = [], [], 0
+    fit = "auto" if measured else "never"
     for i in range(count):
         fam = families[i % len(families)]
         fn, ff = make_law(fam, rng)
-        law = FrictionLaw(fn, ff, rows=np.arange(1, ROWS + 1), source=f"{fam}-{i}")
+        rows = np.arange(1, ROWS + 1)
+        if measured:
+            rows = np.sort(noise.choice(ROWS, MEASURED_ROWS, replace=False)) + 1
+            fn = fn[rows - 1]
+            ff = ff[rows - 1] * (1 + SCATTER * noise.standard_normal(rows.size))
+        law = FrictionLaw(fn, ff, rows=rows, source=f"{fam}-{i}")
         fs = mi.feasible_scale(
-            law, shear_strength=TAU, modulus=E_STAR, radius=RADIUS, area=AREA, fit="never"
+            law, shear_strength=TAU, modulus=E_STAR, radius=RADIUS, area=AREA, fit=fit
         )
         infeasible += not any(fs.ranges.values())
         at = fs.suggest()
@@ -87,7 +100,7 @@ def law_targets(
             e_star=at["modulus"],
             radius=RADIUS,
             area=at["area"],
-            fit="never",
+            fit=fit,
         )
         out.append(mi.Target(p_star=ft.p_star, alpha=ft.alpha, name=f"{fam}-{i}"))
         fams.append(fam)
@@ -127,6 +140,7 @@ def main() -> None:
     t0 = time.perf_counter()
     targets, fams, infeasible = law_targets(args.laws, args.seed)
     held, held_fams, held_bad = law_targets(args.held_out, args.seed + 1, HELD_OUT)
+    measured, _, measured_bad = law_targets(args.laws, args.seed, measured=True)
     cells = realisable_targets(args.cells, args.seed)
     bare = [mi.Target(p_star=t.p_star, alpha=t.alpha, name=t.name) for t in cells]
     with tempfile.TemporaryDirectory() as tmp:
@@ -136,6 +150,7 @@ def main() -> None:
             which: {
                 "laws": zero_shot(targets, path),
                 "held": zero_shot(held, path),
+                "measured": zero_shot(measured, path),
                 "with_s": zero_shot(cells, path),
                 "without_s": zero_shot(bare, path),
             }
@@ -143,6 +158,9 @@ def main() -> None:
         }
     rows = [("all friction laws", "laws", None)]
     rows += [(f"  {f}", "laws", (fams, f)) for f in FAMILIES]
+    rows += [
+        (f"the same laws measured: {MEASURED_ROWS} rows, {SCATTER:.0%} scatter", "measured", None)
+    ]
     rows += [("held-out families", "held", None)]
     rows += [(f"  {f}", "held", (held_fams, f)) for f in HELD_OUT]
     rows += [
@@ -181,7 +199,8 @@ def main() -> None:
     lines += ["", *idle_lines] if idle_lines else []
     text = "\n".join(lines)
     print(text)
-    print(f"{infeasible + held_bad} of {args.laws + args.held_out} laws had no feasible scale")
+    bad, n = infeasible + held_bad + measured_bad, 2 * args.laws + args.held_out
+    print(f"{bad} of {n} laws had no feasible scale")
     print(f"{time.perf_counter() - t0:.1f} s")
     if args.out:
         Path(args.out).write_text(text + "\n")
