@@ -140,7 +140,10 @@ def test_design_reads_friction_laws_with_the_law_network(tmp_path):
     shutil.copy(default_model_path(), alone)
     quick = dict(refine=False, hedge=0, fallback=0, verify=False)
     before = np.array([r.error for r in mi.design(targets, surrogate=alone, **quick)])
-    after = np.array([r.error for r in mi.design(targets, **quick)])
+    made = mi.design(targets, **quick)
+    after = np.array([r.error for r in made])
+    assert any(r.zero_shot_from.startswith("friction-law network") for r in made)
+    assert all(r.record()["zero_shot_from"] == r.zero_shot_from for r in made)
     assert (after <= before + 1e-12).all()
     assert np.median(after) < 0.05 and np.median(after) < 0.5 * np.median(before)
     # a target with its stiffness is read by the shipped surrogate alone, as before
@@ -150,6 +153,8 @@ def test_design_reads_friction_laws_with_the_law_network(tmp_path):
     a = mi.design(with_s, surrogate=alone, **quick)
     b = mi.design(with_s, **quick)
     np.testing.assert_array_equal(a.design.gamma, b.design.gamma)
+    assert b.zero_shot_from == "surrogate"
+    assert mi.design(with_s, method="multistart", starts=2, **quick).zero_shot_from == ""
 
 
 def test_a_refined_design_is_never_worse_than_its_start():

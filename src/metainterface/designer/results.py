@@ -58,6 +58,11 @@ class DesignResult(ReachCounts):
         The forward model designed with.
     start : int
         Which start won (0 = the zero-shot prediction); see :attr:`origin`.
+    zero_shot_from : str
+        Which network made the zero-shot design, and from which view of the target:
+        ``"surrogate"``, or for a target without stiffness also e.g. ``"friction-law
+        network"`` or ``"surrogate, end x0.4"`` (its end cut to 0.4 of its largest
+        pressure); ``""`` for the baselines.
     fallback : bool
         The design came from the fallback multistart.
     notes : tuple of str
@@ -100,6 +105,7 @@ class DesignResult(ReachCounts):
     seconds: float
     model: ForwardModel = field(default_factory=get_model)
     start: int = 0
+    zero_shot_from: str = ""
     fallback: bool = False
     notes: tuple[str, ...] = ()
     pressure: PressureCheck | None = None
@@ -188,6 +194,7 @@ class DesignResult(ReachCounts):
             "carrying_asperities": self.carrying,
             **({"forced": True} if self.forced else {}),
             "zero_shot_error": self.initial_error,
+            **({"zero_shot_from": self.zero_shot_from} if self.zero_shot_from else {}),
             "seconds": self.seconds,
             **({"notes": list(self.notes)} if self.notes else {}),
             **({"pressure_check": self.pressure.to_dict()} if self.pressure else {}),

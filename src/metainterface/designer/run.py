@@ -357,6 +357,7 @@ def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> Desi
         seconds=r.seconds,
         model=r.model,
         start=r.start,
+        zero_shot_from=r.zero_shot_from,
         fallback=r.fallback,
         notes=notes,
         pressure=pressure,

@@ -31,3 +31,5 @@ class DesignResult:
     robust_error: float | None = None
     # printable heights: errors before the snap to the layer grid, after it, and the step
     quantisation: dict | None = None
+    # which network (and view of the target) made the zero-shot design; "" for baselines
+    zero_shot_from: str = ""

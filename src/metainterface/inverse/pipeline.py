@@ -272,7 +272,7 @@ def _design(
         settings = model_settings
         gamma0, h0 = predict(net, targets, settings)
         laws_net = shipped_laws_net(model_path, settings, targets)
-        gamma0, h0 = best_views(
+        gamma0, h0, zero_shot_from = best_views(
             net, targets, gamma0, h0, settings, model, refine_settings.grid_points, laws_net
         )
         per_target = 1 + max(hedge, 0)
@@ -281,6 +281,7 @@ def _design(
             gamma0 = torch.cat([gamma0[:, None], g_r], 1).flatten(0, 1)
             h0 = torch.cat([h0[:, None], h_r], 1).flatten(0, 1)
     else:
+        zero_shot_from = [""] * len(targets)
         settings = settings or CellSettings()
         per_target = starts
         gamma0, h0 = random_starts(starts, len(targets), settings, seed, METHODS[method])
@@ -356,6 +357,7 @@ def _design(
             model=model,
             start=int(winner[i]),
             robust_error=None if perturb is None else float(rank[b]),
+            zero_shot_from=zero_shot_from[i],
         )
         for i, (t, b) in enumerate(zip(targets, best.tolist(), strict=True))
     ]

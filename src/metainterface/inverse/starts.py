@@ -30,6 +30,10 @@ if TYPE_CHECKING:  # the surrogate (and its imports) load only when a design nee
     from metainterface.surrogate.model import InverseMLP
 
 
+#: How a zero-shot design's source is named (DesignResult.zero_shot_from).
+SURROGATE, LAWS_NETWORK = "surrogate", "friction-law network"
+
+
 def random_starts(
     count: int, n_targets: int, settings: CellSettings, seed: int, param: Parameterisation
 ) -> tuple[Tensor, Tensor]:
@@ -139,25 +143,30 @@ def best_views(
     model: ForwardModel,
     points: int,
     laws_net: InverseMLP | None = None,
-) -> tuple[Tensor, Tensor]:
+) -> tuple[Tensor, Tensor, list[str]]:
     """The zero-shot designs (T, N), each target without stiffness given the best, by the
     error on the target itself, of its own prediction (gamma0, h0), those of its views
     (:func:`target_views`), and, with ``laws_net`` (the network trained on targets made the
-    way friction laws arrive), that network's on the target and its views."""
+    way friction laws arrive), that network's on the target and its views. Also, per
+    target, which prediction it is (e.g. ``"friction-law network, end x0.4"``)."""
     gamma0, h0 = gamma0.clone(), h0.clone()
+    labels = [SURROGATE] * len(targets)
     for i, t in enumerate(targets):
         if t.stiffness is not None:
             continue
         views = target_views(t)
-        g_c, h_c = [gamma0[i : i + 1]], [h0[i : i + 1]]
+        ends = [f", end x{v.p_star_max / t.p_star_max:.2g}" for v in views]
+        g_c, h_c, names = [gamma0[i : i + 1]], [h0[i : i + 1]], [SURROGATE]
         if views:
             g_v, h_v = predict(net, views, settings)
             g_c.append(g_v)
             h_c.append(h_v)
+            names += [SURROGATE + e for e in ends]
         if laws_net is not None:
             g_l, h_l = predict(laws_net, [t, *views], settings)
             g_c.append(g_l)
             h_c.append(h_l)
+            names += [LAWS_NETWORK + e for e in ["", *ends]]
         if len(g_c) == 1:
             continue
         g, h = torch.cat(g_c), torch.cat(h_c)
@@ -166,8 +175,8 @@ def best_views(
             g, h, settings, grid.rows(torch.zeros(g.shape[0], dtype=torch.long)), model
         )
         k = int(err.argmin())
-        gamma0[i], h0[i] = g[k], h[k]
-    return gamma0, h0
+        gamma0[i], h0[i], labels[i] = g[k], h[k], names[k]
+    return gamma0, h0, labels
 
 
 def shipped_laws_net(
