@@ -91,6 +91,7 @@ def test_training_the_law_network_from_the_cli(cells, tmp_path, capsys):
     _, settings, config = load_model(run / "model.pt")
     assert settings == S and config["train"]["reads"] == "laws"
     assert config["train"]["init"] == str(default_model_path())
+    assert config["init_sha256"].startswith("sha256:")  # which file, wherever it lies
     assert config["train"]["w_shape"] == 0 and config["train"]["w_curve"] == 100
     capsys.readouterr()
     assert main(["evaluate", "--model", str(run / "model.pt"), "--dataset", str(path)]) == 0

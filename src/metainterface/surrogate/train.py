@@ -15,6 +15,7 @@ so it is comparable across epochs while kappa_s anneals.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import time
@@ -31,7 +32,7 @@ from metainterface._device import resolve_device
 from metainterface._files import strict_json
 from metainterface._files.atomic import output_set, write_text
 from metainterface._files.columns import write_columns
-from metainterface._files.provenance import provenance
+from metainterface._files.provenance import HASH_DIGITS, provenance
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import curve
@@ -324,6 +325,7 @@ def train(
         "model": model.architecture(),
         "train": asdict(config),
         "dataset": dataset_info or {},
+        **({"init_sha256": _file_hash(config.init)} if config.init else {}),
         "provenance": provenance(),
     }
     write_text(out / "config.json", strict_json.dumps(run_info, indent=2, default=str) + "\n")
@@ -426,6 +428,15 @@ def train(
             break
     bar.close()
     return TrainResult(out, len(history), best_epoch, best, stopped, time.perf_counter() - t_run)
+
+
+def _file_hash(path: str) -> str | None:
+    """'sha256:<hex>' of a file's bytes: names the model a run started from, wherever it is
+    (None if it is gone, as it may be when a run is resumed)."""
+    if not Path(path).is_file():
+        return None
+    digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    return "sha256:" + digest[:HASH_DIGITS]
 
 
 def _start_from(model: InverseMLP, path: str, settings: CellSettings, features) -> None:
