@@ -1,6 +1,7 @@
 """The friction-law network: how targets without stiffness are read, the targets it is
 trained on, its training from the shipped surrogate, and what it does for friction laws."""
 
+import json
 import shutil
 
 import numpy as np
@@ -170,3 +171,19 @@ def test_a_refined_design_is_never_worse_than_its_start():
     r = mi.design(target, hedge=0, fallback=0, verify=False, force=True)
     # (re-seeding idle asperities may trade a little error for a cell that uses them)
     assert r.error <= max(r.initial_error * (1 + RESEED_SLACK), r.initial_error + RESEED_FLOOR)
+
+
+@pytest.mark.skipif(not default_laws_model_path().is_file(), reason="no shipped laws network")
+def test_the_cli_says_which_reading_of_a_law_made_the_zero_shot_design(tmp_path, capsys):
+    fn = np.linspace(0.2, 8.0, 40)
+    csv = tmp_path / "law.csv"
+    rows = "".join(f"{x:.6g},{20 * (1 - np.exp(-x / 3)):.6g}\n" for x in fn)
+    csv.write_text("normal_force,friction_force\n" + rows)
+    out = tmp_path / "d"
+    args = ["design", "--friction-csv", str(csv), "--shear-strength", "0.25MPa", "--modulus"]
+    args += ["2MPa", "--radius", "0.5mm", "--area", "30cm2", "--no-verify", "--out", str(out)]
+    assert main(args) == 0
+    said = capsys.readouterr().out
+    record = json.loads((out / "design.json").read_text())
+    assert record["zero_shot_from"].startswith("friction-law network")
+    assert f"zero-shot read by: law: {record['zero_shot_from']}" in said

@@ -47,6 +47,10 @@ def table(args: argparse.Namespace, results: list) -> None:
         "error: sqrt(fit^2 + (1 - coverage)^2), fit over the loads the design reaches; "
         "coverage: the share of the target's load range it reaches"
     )
+    others = [r for r in results if r.zero_shot_from not in ("", "surrogate")]
+    if others:  # targets without stiffness: say which reading of the target won
+        said = "; ".join(f"{r.target.name}: {r.zero_shot_from}" for r in others)
+        print(f"zero-shot read by: {said} (the prediction closest to the target kept)")
     if checked:
         print(_bem_legend(checked))
 
