@@ -121,10 +121,47 @@ def idle_count(r) -> int:
     return int(idle.sum())
 
 
+def zero_shot_designs(targets: list[mi.Target], surrogate: str | None = None) -> list:
+    """Zero-shot designs; ``surrogate`` a model file (None: `design`'s default networks)."""
+    return mi.design(targets, refine=False, hedge=0, fallback=0, verify=False, surrogate=surrogate)
+
+
 def zero_shot(targets: list[mi.Target], surrogate: str | None = None) -> np.ndarray:
-    """Zero-shot errors; ``surrogate`` a model file (None: `design`'s default networks)."""
-    rs = mi.design(targets, refine=False, hedge=0, fallback=0, verify=False, surrogate=surrogate)
-    return np.array([r.error for r in rs])
+    """Zero-shot errors, as :func:`zero_shot_designs`."""
+    return np.array([r.error for r in zero_shot_designs(targets, surrogate)])
+
+
+def figure(targets: list[mi.Target], fams: list[str], alone: str, path: str) -> None:
+    """One law a family (the one with the median gain): the law, and the zero-shot designs of
+    the surrogate alone and of `design` with the friction-law network."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    before, after = zero_shot_designs(targets, alone), zero_shot_designs(targets)
+    fig, axes = plt.subplots(1, len(FAMILIES), figsize=(12, 3.3), constrained_layout=True)
+    for ax, fam in zip(axes, FAMILIES, strict=True):
+        idx = [i for i, f in enumerate(fams) if f == fam]
+        gain = [before[i].error - after[i].error for i in idx]
+        i = idx[int(np.argsort(gain)[len(gain) // 2])]
+        t, top = targets[i], targets[i].p_star_max
+        ax.plot(1e3 * t.p_star, t.alpha, "o", ms=3, color="k", label="law (40 rows)")
+        for r, style, name in (
+            (before[i], "--", "surrogate alone"),
+            (after[i], "-", "with the friction-law network"),
+        ):
+            c = r.curve()
+            keep = c.p_star <= top
+            ax.plot(
+                1e3 * c.p_star[keep], c.alpha[keep], style, label=f"{name}: {100 * r.error:.2g} %"
+            )
+        ax.set_title(f"{fam} ({t.name})", fontsize=9)
+        ax.set_xlabel(r"$P^*$ ($\times 10^{-3}$)")
+        ax.legend(fontsize=7, loc="lower right")
+    axes[0].set_ylabel(r"$\alpha$")
+    fig.suptitle("Zero-shot designs of friction laws (no stiffness column)", fontsize=10)
+    fig.savefig(path, dpi=110)
 
 
 def main() -> None:
@@ -135,6 +172,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--refine", action="store_true", help="also the refined error (slow)")
     ap.add_argument("--out", help="write the markdown table here")
+    ap.add_argument("--figure", help="draw one law a family with both zero-shot designs here")
     args = ap.parse_args()
     from bench_design import realisable_targets
     from metainterface.surrogate.checkpoint import default_model_path
@@ -148,6 +186,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         alone = str(Path(tmp) / "surrogate.pt")
         shutil.copy(default_model_path(), alone)
+        if args.figure:
+            figure(targets, fams, alone, args.figure)
         runs = {
             which: {
                 "laws": zero_shot(targets, path),
