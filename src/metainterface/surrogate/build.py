@@ -87,8 +87,8 @@ def train_surrogate(
     if config.reads == "laws":
         with torch.inference_mode():
             # the validation targets get their own seed: other cuts of other cells
-            train_split = law_split(train_split, ds.settings, config.seed)
-            val_split = law_split(val_split, ds.settings, config.seed + 1)
+            train_split = law_split(train_split, ds.settings, config.seed, progress=progress)
+            val_split = law_split(val_split, ds.settings, config.seed + 1, progress=progress)
     return train(
         train_split,
         val_split,
@@ -108,12 +108,16 @@ def train_surrogate(
 
 
 def evaluate_surrogate(
-    dataset: str | os.PathLike[str], surrogate: str | os.PathLike[str] | None = None
+    dataset: str | os.PathLike[str],
+    surrogate: str | os.PathLike[str] | None = None,
+    *,
+    progress: bool = True,
 ) -> dict[str, Any]:
     """Zero-shot errors of a surrogate on a dataset's test split, per category and overall
     (median and 90th-percentile relative curve error, log10 errors of P*_max and alpha_max)
     and the train/test loss gap. A friction-law network (``TrainConfig.laws``) is evaluated
-    on friction-law-like targets made from the split's cells, per kind."""
+    on friction-law-like targets made from the split's cells, per kind (``progress``: a
+    bar while they are made)."""
     path = Path(surrogate) if surrogate is not None else default_model_path()
     model, settings, config = load_model(path)
     ds = load_dataset(dataset, settings)
@@ -121,6 +125,6 @@ def evaluate_surrogate(
     reads = config.get("train", {}).get("reads", "curves")
     if reads == "laws":  # its own kind of targets, made from the test cells (fixed seeds)
         with torch.inference_mode():
-            train_split = law_split(train_split, settings, LAW_SEEDS[0])
-            test_split = law_split(test_split, settings, LAW_SEEDS[1])
+            train_split = law_split(train_split, settings, LAW_SEEDS[0], progress=progress)
+            test_split = law_split(test_split, settings, LAW_SEEDS[1], progress=progress)
     return evaluate(model, train_split, test_split, settings, weights_of(config), reads)

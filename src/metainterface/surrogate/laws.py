@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 from torch import Tensor
+from tqdm.auto import tqdm
 
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
@@ -94,6 +95,7 @@ def law_split(
     seed: int,
     spec: LawTargets | None = None,
     chunk: int = 4096,
+    progress: bool = False,
 ) -> Split:
     """Friction-law-like targets (S copies rows) made from the cells of ``split`` (S rows).
 
@@ -119,7 +121,8 @@ def law_split(
     p_max = torch.empty(total)
     a_max = torch.empty(total)
     unit = torch.linspace(0, 1, spec.delta_samples, dtype=torch.float64)
-    for lo in range(0, total, chunk):
+    chunks = range(0, total, chunk)
+    for lo in tqdm(chunks, desc="law targets", unit="chunk", disable=not progress):
         sl = slice(lo, min(lo + chunk, total))
         delta = unit[None] * (end[sl] * settings.delta_max)[:, None]
         sw = sweep(gamma[sl], h[sl], settings, delta=delta)
