@@ -104,6 +104,10 @@ def test_training_the_law_network_from_the_cli(cells, tmp_path, capsys):
     bad = ["train", "--dataset", str(path), "--laws", "--init", str(tmp_path / "no.pt")]
     assert main([*bad, "--out", str(tmp_path / "r2")]) == 2
     assert "no.pt: file not found" in capsys.readouterr().err
+    four = tmp_path / "four.npz"  # another cell than the shipped surrogate's
+    mi.generate_dataset(200, four, seed=1, settings=CellSettings(n_asperities=4), progress=False)
+    assert main(["train", "--dataset", str(four), "--laws", "--out", str(tmp_path / "r4")]) == 2
+    assert "trained for another cell" in capsys.readouterr().err
 
 
 def _law_targets():

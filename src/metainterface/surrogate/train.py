@@ -446,7 +446,10 @@ def _start_from(model: InverseMLP, path: str, settings: CellSettings, features) 
     nothing; their weights start at 0."""
     src, trained, _ = load_model(path)
     if trained != settings:
-        raise MetainterfaceError(f"init model {path}: trained for another cell than the dataset's")
+        raise MetainterfaceError(
+            f"init model {path}: trained for another cell than the dataset's; give --init "
+            "(TrainConfig.init) a model trained on this dataset's cell"
+        )
     if src.max_gap != model.max_gap:
         raise MetainterfaceError(
             f"init model {path}: max_gap {src.max_gap} differs from this run's {model.max_gap}"
