@@ -106,7 +106,8 @@ def test_training_the_law_network_from_the_cli(cells, tmp_path, capsys):
     assert "no.pt: file not found" in capsys.readouterr().err
     four = tmp_path / "four.npz"  # another cell than the shipped surrogate's
     mi.generate_dataset(200, four, seed=1, settings=CellSettings(n_asperities=4), progress=False)
-    assert main(["train", "--dataset", str(four), "--laws", "--out", str(tmp_path / "r4")]) == 2
+    four_args = ["train", "--dataset", str(four), "--laws", "--batch-size", "32"]
+    assert main([*four_args, "--out", str(tmp_path / "r4")]) == 2
     assert "trained for another cell" in capsys.readouterr().err
 
 
