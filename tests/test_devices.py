@@ -190,6 +190,20 @@ def test_many_targets_pass_the_memory_check(monkeypatch):
     assert "\n" not in str(e.value)
 
 
+def test_the_memory_check_counts_a_robust_designs_copies(monkeypatch):
+    """A robust design refines each start on its perturbed copies as well."""
+    from metainterface import _checks
+
+    monkeypatch.setattr(_checks, "memory_total", lambda: 16 * 2**30)
+    t = mi.Target.builtin("saturating")
+    # 300 x 9 rows x 9 asperities: 0.4 GB alone, 26 GB robust
+    many = [mi.Target(p_star=t.p_star, alpha=t.alpha, name=f"t{i}") for i in range(300)]
+    robust = mi.Robust(sigma_h=0.001, samples=64)
+    with pytest.raises(MetainterfaceError, match=r"with 64 robust samples each") as e:
+        mi.design(many, robust=robust, hedge=8, fallback=0, verify=False)
+    assert "\n" not in str(e.value)
+
+
 BAD = "gpu"
 
 

@@ -63,7 +63,12 @@ def _targets(targets: Target | str | Sequence[Target | str]) -> tuple[list[Targe
         out.append(t)
     names = [t.name for t in out]
     if len(set(names)) != len(names):
-        raise MetainterfaceError(f"target names must be distinct, got {', '.join(names)}")
+        twice = sorted({n for n in names if names.count(n) > 1})
+        said = ", ".join(f"{n!r} {names.count(n)} times" for n in twice[:5])
+        more = f" and {len(twice) - 5} more names" if len(twice) > 5 else ""
+        raise MetainterfaceError(
+            f"target names must be distinct (each names its output), got {said}{more}"
+        )
     return out, single
 
 
@@ -217,7 +222,6 @@ def design(
     seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
     n = (settings or CellSettings()).n_asperities
     dev = resolve_device(device)
-    affordable_rows(method, starts, hedge, fallback, len(items), n, dev)
     if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
         raise MetainterfaceError("refine_settings must be a RefineSettings")
     if not isinstance(refine, bool):
@@ -247,6 +251,9 @@ def design(
         settings,
         seed,
     )
+    # robust design refines every start on its perturbed copies too
+    copies = 1 if perturb is None else 1 + perturb.z.shape[0]
+    affordable_rows(method, starts, hedge, fallback, len(items), n, dev, copies)
     raw = pipeline.design(
         items,
         method,
@@ -282,17 +289,27 @@ def design(
 
 
 def affordable_rows(
-    method: str, starts: int, hedge: int, fallback: int, targets: int, n: int, device: Any
+    method: str,
+    starts: int,
+    hedge: int,
+    fallback: int,
+    targets: int,
+    n: int,
+    device: Any,
+    copies: int = 1,
 ) -> None:
     """Refuse a design whose largest batch would not fit in memory (the GPU's on CUDA).
 
     The rows refined together: ``starts`` per target by multistart and Hertz; by the
     surrogate, 1 + ``hedge`` per target, then ``fallback`` per target for the targets it
     missed, in a batch of its own after the first is freed (so the larger of the two, not
-    their sum)."""
+    their sum); each with ``copies`` curves (a robust design's nominal one and its perturbed
+    copies)."""
     per_target = starts if method != "surrogate" else max(1 + hedge, fallback)
-    nbytes = per_target * targets * n * BYTES_PER_START
+    nbytes = per_target * targets * n * copies * BYTES_PER_START
     what = f" for {targets} targets" if targets > 1 else ""
+    if copies > 1:
+        what += f" with {copies - 1} robust samples each"
     if device.type != "cuda":
         _checks.affordable("starts", starts, nbytes, what=what)
         return
