@@ -9,10 +9,9 @@ import numpy as np
 
 from metainterface.errors import MetainterfaceError, UnreachableError
 from metainterface.inverse.targets import Target
-from metainterface.physical.friction import FrictionLaw, friction_target
+from metainterface.physical.friction import FrictionLaw, friction_target_in_units
 from metainterface.physical.reach import Reachability
 from metainterface.physical.reach import reachability as _reachability
-from metainterface.physical.units import parse_area, parse_length, parse_pressure
 from metainterface.physics.cell import CellSettings
 
 
@@ -66,12 +65,12 @@ def reachability(
             f"a friction law needs shear_strength, modulus and area (missing {', '.join(missing)})",
             argument=missing[0],
         )
-    ft = friction_target(
+    ft = friction_target_in_units(
         law,
-        shear_strength=parse_pressure(shear_strength, option="shear_strength"),
-        e_star=parse_pressure(modulus, option="modulus"),
-        radius=parse_length(radius, option="radius"),
-        area=parse_area(area, option="area"),
+        shear_strength=shear_strength,
+        modulus=modulus,
+        radius=radius,
+        area=area,
         settings=settings,
     )
     return _reachability(

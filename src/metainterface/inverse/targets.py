@@ -144,15 +144,14 @@ class Target:
         "always" or "never" force it; the fit and its residual are in
         ``meta["friction"]["fit"]``.
         """
-        from metainterface.physical.friction import friction_target
-        from metainterface.physical.units import parse_area, parse_length, parse_pressure
+        from metainterface.physical.friction import friction_target_in_units
 
-        ft = friction_target(
+        ft = friction_target_in_units(
             law,
-            shear_strength=parse_pressure(shear_strength, option="shear_strength"),
-            e_star=parse_pressure(modulus, option="modulus"),
-            radius=parse_length(radius, option="radius"),
-            area=parse_area(area, option="area"),
+            shear_strength=shear_strength,
+            modulus=modulus,
+            radius=radius,
+            area=area,
             settings=settings,
             fit=fit,
         )

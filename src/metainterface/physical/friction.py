@@ -371,8 +371,6 @@ def friction_target_from_options(
 
     Errors name the options --friction-csv, --shear-strength, --modulus, --radius, --area.
     """
-    from metainterface.physical.units import parse_area, parse_length, parse_pressure
-
     given = {
         "--shear-strength": shear_strength,
         "--modulus": modulus,
@@ -385,12 +383,43 @@ def friction_target_from_options(
             f"--friction-csv needs --shear-strength, --modulus, --radius and --area "
             f"(missing {', '.join(missing)})"
         )
-    return friction_target(
+    return friction_target_in_units(
         path,
-        shear_strength=parse_pressure(shear_strength, option="--shear-strength"),
-        e_star=parse_pressure(modulus, option="--modulus"),
-        radius=parse_length(radius, option="--radius"),
-        area=parse_area(area, option="--area"),
+        shear_strength=shear_strength,
+        modulus=modulus,
+        radius=radius,
+        area=area,
+        settings=settings,
+        fit=fit,
+        options=True,
+    )
+
+
+def friction_target_in_units(
+    law: FrictionLaw | str | os.PathLike[str],
+    *,
+    shear_strength: str | float,
+    modulus: str | float,
+    radius: str | float,
+    area: str | float,
+    settings: CellSettings | None = None,
+    fit: str = "auto",
+    options: bool = False,
+) -> FrictionTarget:
+    """:func:`friction_target` from quantities with units ('0.25MPa', '0.5mm', '4cm2') or
+    numbers in SI. A bad quantity's error names its argument (``shear_strength``), or with
+    ``options`` the command-line option (``--shear-strength``)."""
+    from metainterface.physical.units import parse_area, parse_length, parse_pressure
+
+    def name(arg: str) -> str:
+        return "--" + arg.replace("_", "-") if options else arg
+
+    return friction_target(
+        law,
+        shear_strength=parse_pressure(shear_strength, option=name("shear_strength")),
+        e_star=parse_pressure(modulus, option=name("modulus")),
+        radius=parse_length(radius, option=name("radius")),
+        area=parse_area(area, option=name("area")),
         settings=settings,
         fit=fit,
     )
