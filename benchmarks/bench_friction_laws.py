@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 import metainterface as mi
-from metainterface.physical.friction import FrictionLaw, friction_target
+from metainterface.physical.friction import FrictionLaw, friction_target_in_units
 
 sys.path.insert(0, str(Path(__file__).parent))
 
@@ -95,15 +95,7 @@ def law_targets(
             law, shear_strength=TAU, modulus=E_STAR, radius=RADIUS, area=AREA, fit=fit
         )
         infeasible += not any(fs.ranges.values())
-        at = fs.suggest()
-        ft = friction_target(
-            law,
-            shear_strength=at["shear_strength"],
-            e_star=at["modulus"],
-            radius=RADIUS,
-            area=at["area"],
-            fit=fit,
-        )
+        ft = friction_target_in_units(law, **fs.suggest(), fit=fit)
         out.append(mi.Target(p_star=ft.p_star, alpha=ft.alpha, name=f"{fam}-{i}"))
         fams.append(fam)
     return out, fams, infeasible

@@ -13,7 +13,7 @@ from metainterface.cli import main
 from metainterface.data import load_dataset
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.reseed import RESEED_FLOOR, RESEED_SLACK
-from metainterface.physical.friction import FrictionLaw, friction_target
+from metainterface.physical.friction import FrictionLaw, friction_target, friction_target_in_units
 from metainterface.physics import CellSettings
 from metainterface.physics.curves import normalised_from_points
 from metainterface.physics.pressures import alpha_at
@@ -126,16 +126,8 @@ def _law_targets():
         fs = mi.feasible_scale(
             law, shear_strength=TAU, modulus=E_STAR, radius=RADIUS, area=AREA, fit="never"
         )
-        at = fs.suggest()
         assert any(fs.ranges.values()), name  # reachable at some scale
-        t = friction_target(
-            law,
-            shear_strength=at["shear_strength"],
-            e_star=at["modulus"],
-            radius=RADIUS,
-            area=at["area"],
-            fit="never",
-        )
+        t = friction_target_in_units(law, **fs.suggest(), fit="never")
         out.append(mi.Target(p_star=t.p_star, alpha=t.alpha, name=name))
     return out
 
