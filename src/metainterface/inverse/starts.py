@@ -199,16 +199,10 @@ def shipped_laws_net(
     return net if trained == settings else None
 
 
-#: Training-set spread below which an input counts as constant (alpha_hat at both ends,
-#: S_hat at P* = 0).
-CONSTANT_STD = 1e-4
-
-
 def conform(net: InverseMLP, features: Tensor) -> Tensor:
     """Features (F,) as a (1, F) float64 batch, with the inputs that were constant in the
     network's training set set to that constant. The standardisation divides them by a
     spread of ~1e-6: a target that differs there by round-off or an estimate (S* at P* = 0
     by finite differences) would push the first layer 1e5 standard deviations away."""
     x = features.to(DTYPE)[None]
-    fixed = net.in_std.to(DTYPE) < CONSTANT_STD
-    return torch.where(fixed, net.in_mean.to(DTYPE), x)
+    return torch.where(net.constant_inputs(), net.in_mean.to(DTYPE), x)

@@ -27,6 +27,9 @@ from metainterface.physics.cell import CellSettings
 HIDDEN = (512, 256, 128)
 DROPOUT = 0.1
 MAX_GAP = 1.1  # default gap scale G / Delta_max of new models (see the module docstring)
+#: Training-set spread below which an input counts as constant (for exact curves:
+#: alpha_hat at both ends, S_hat at P* = 0).
+CONSTANT_STD = 1e-4
 
 
 def check_max_gap(max_gap: float | None) -> float | None:
@@ -94,6 +97,11 @@ class InverseMLP(nn.Module):
         """Standardise inputs by the mean and std of ``features`` (B, 2 n_steps + 2)."""
         self.in_mean.copy_(features.mean(0))
         self.in_std.copy_(features.std(0).clamp_min(1e-6))
+
+    def constant_inputs(self) -> Tensor:
+        """(2 n_steps + 2,) bool: the inputs that did not vary where the network was trained
+        (spread below CONSTANT_STD); it learned nothing from them."""
+        return self.in_std < CONSTANT_STD
 
     def forward(self, features: Tensor) -> Tensor:
         return self.net((features - self.in_mean) / self.in_std)

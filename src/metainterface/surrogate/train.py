@@ -442,8 +442,8 @@ def _file_hash(path: str) -> str | None:
 def _start_from(model: InverseMLP, path: str, settings: CellSettings, features) -> None:
     """Load a model file's weights into ``model`` and refit the input standardisation to
     ``features``, folding the change into the first layer so the network computes what the
-    file's did. Inputs that were constant where the file was trained (spread < 1e-4) carried
-    nothing; their weights start at 0."""
+    file's did. Inputs that were constant where the file was trained
+    (``InverseMLP.constant_inputs``) carried nothing; their weights start at 0."""
     src, trained, _ = load_model(path)
     if trained != settings:
         raise MetainterfaceError(
@@ -457,8 +457,8 @@ def _start_from(model: InverseMLP, path: str, settings: CellSettings, features) 
     with torch.no_grad():
         model.load_state_dict(src.state_dict())
         old_mean, old_std = model.in_mean.clone(), model.in_std.clone()
+        live = ~model.constant_inputs()
         model.set_input_scaling(features)
-        live = old_std >= 1e-4
         scale = torch.where(live, model.in_std / old_std, 0.0)
         shift = torch.where(live, (model.in_mean - old_mean) / old_std, 0.0)
         first = model.net[0]
