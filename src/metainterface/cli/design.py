@@ -223,28 +223,18 @@ def _targets(args: argparse.Namespace) -> list:
     targets = [mi.Target.builtin(n) for n in args.target]
     targets += [mi.Target.from_csv(f) for f in args.target_csv]
     if args.friction_csv and not _scale_free(args):
-        given = {
-            "--shear-strength": args.shear_strength,
-            "--modulus": args.modulus,
-            "--radius": args.radius,
-            "--area": args.area,
-        }
-        missing = [name for name, value in given.items() if value is None]
-        if missing:
-            raise mi.MetainterfaceError(
-                "--friction-csv needs --shear-strength, --modulus, --radius and --area "
-                f"(missing {', '.join(missing)})"
-            )
-        targets.append(
-            mi.Target.from_friction(
-                args.friction_csv,
-                shear_strength=args.shear_strength,
-                modulus=args.modulus,
-                radius=args.radius,
-                area=args.area,
-                fit=args.fit,
-            )
+        from metainterface.inverse.targets import friction_law_target
+        from metainterface.physical.friction import friction_target_from_options
+
+        ft = friction_target_from_options(
+            args.friction_csv,
+            shear_strength=args.shear_strength,
+            modulus=args.modulus,
+            radius=args.radius,
+            area=args.area,
+            fit=args.fit,
         )
+        targets.append(friction_law_target(ft, args.friction_csv))
         fit = targets[-1].meta["friction"].get("fit")
         if fit is not None:
             print(f"{targets[-1].name}: {fit['summary']}")

@@ -22,6 +22,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import torch
@@ -155,13 +156,20 @@ class Target:
             settings=settings,
             fit=fit,
         )
-        return cls(
-            p_star=ft.p_star,
-            alpha=ft.alpha,
-            name=name or Path(law).stem,
-            source=str(law),
-            meta={"friction": ft.record()},
-        )
+        return friction_law_target(ft, law, name)
+
+
+def friction_law_target(ft: Any, source: str | os.PathLike[str], name: str | None = None) -> Target:
+    """The Target of a converted friction law (a ``physical.friction.FrictionTarget``) read
+    from the CSV ``source``: named after the file unless ``name``; the conversion in
+    ``meta["friction"]``."""
+    return Target(
+        p_star=ft.p_star,
+        alpha=ft.alpha,
+        name=name or Path(source).stem,
+        source=str(source),
+        meta={"friction": ft.record()},
+    )
 
 
 def _column(where: str, name: str, values: object) -> np.ndarray:
