@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from math import nan
 
 import numpy as np
 import torch
@@ -94,8 +93,10 @@ def evaluate(
             "samples": int(m.sum()),
             "median_curve_error": float(np.median(pred.curve_error[m])),
             "p90_curve_error": float(np.percentile(pred.curve_error[m], 90)),
-            "mean_abs_log10_p_star_max_error": nan if laws else float(pred.log_p_error[m].mean()),
-            "mean_abs_log10_alpha_max_error": nan
+            "mean_abs_log10_p_star_max_error": math.nan
+            if laws
+            else float(pred.log_p_error[m].mean()),
+            "mean_abs_log10_alpha_max_error": math.nan
             if laws
             else float(pred.log_alpha_error[m].mean()),
         }
