@@ -45,6 +45,8 @@ Manufacturing errors
 Your own design space
     generate_dataset, train_surrogate, TrainConfig, evaluate_surrogate
 Process settings
+    set_threads (torch's CPU threads for metainterface's work; by default one for designs
+    and BEM, all for training, and the user's OMP_NUM_THREADS or torch.set_num_threads wins),
     tune_allocator (keep freed tensor memory in the heap; the CLI calls it)
 
 numpy arrays and lists go in, numpy comes out; the differentiable torch engine is in
@@ -56,6 +58,12 @@ import sys
 import types
 from importlib.metadata import PackageNotFoundError, version
 from typing import TYPE_CHECKING, Any
+
+from metainterface import _threads
+
+# Before anything loads torch: its OpenMP threads should sleep, not spin, while they wait
+# (a busy machine made them 10-18x slower; metainterface._threads says why and how).
+_threads.prepare_process()
 
 try:
     #: The installed package's version (PEP 440); "0+unknown" in an uninstalled source tree.
@@ -105,6 +113,7 @@ _HOMES: dict[str, str] = {
     "get_model": "metainterface.physics.models",
     "register_model": "metainterface.physics.models",
     "tune_allocator": "metainterface.runtime",
+    "set_threads": "metainterface._threads",
     "TrainConfig": "metainterface.surrogate.train",
     "ValidationResult": "metainterface.validation.result",
     "FeasibleScale": "metainterface.inverse.scale",
@@ -113,6 +122,7 @@ _HOMES: dict[str, str] = {
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
+    from metainterface._threads import set_threads
     from metainterface.designer.curves import Curve
     from metainterface.designer.given import curve, export, physical, pressure_check
     from metainterface.designer.options import Effort, Robust, Scale
@@ -215,6 +225,7 @@ __all__ = [
     "pressure_check",
     "reachability",
     "register_model",
+    "set_threads",
     "tolerance",
     "train_surrogate",
     "tune_allocator",

@@ -17,6 +17,7 @@ import sys
 from collections.abc import Sequence
 from typing import NoReturn
 
+from metainterface.cli.common import positive_int
 from metainterface.errors import MetainterfaceError
 
 # Subcommand modules, in the order `--help` lists them.
@@ -38,6 +39,10 @@ COMMANDS: tuple[str, ...] = (
 #: design's files are one set inside mi.design / mi.compare already, so that --html can
 #: read them back to make the page (a file staged in a set is not there yet).
 ALL_OR_NOTHING = frozenset({"curve", "export", "generate", "evaluate"})
+
+#: Commands whose torch work is large batched kernels (all of torch's threads where they
+#: sleep while waiting); the others run on one thread a process (metainterface._threads).
+HEAVY = frozenset({"generate", "train", "evaluate"})
 
 #: Library argument names that a command's options spell differently.
 OPTION_NAMES = {
@@ -71,6 +76,14 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in COMMANDS:
         importlib.import_module(f"metainterface.cli.{name}").register(sub)
+    for command in sub.choices.values():  # one --threads for every command, said once here
+        command.add_argument(
+            "--threads",
+            type=positive_int,
+            metavar="N",
+            help="torch CPU threads (default: chosen per task, one for designs and BEM, all for "
+            "training; OMP_NUM_THREADS is honoured)",
+        )
     return parser
 
 
@@ -79,14 +92,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     import contextlib
 
     from metainterface._files import output_set, terminate_as_interrupt
+    from metainterface._threads import set_threads, threads_for
     from metainterface.runtime import tune_allocator
 
     parser = build_parser()
     args = parser.parse_args(argv)
     tune_allocator()
+    if args.threads is not None:
+        set_threads(args.threads)
     whole = output_set() if args.command in ALL_OR_NOTHING else contextlib.nullcontext()
+    work = "heavy" if args.command in HEAVY else "light"
     try:
-        with terminate_as_interrupt(), whole:
+        with terminate_as_interrupt(), whole, threads_for(work):
             return int(args.func(args) or 0)
     except MetainterfaceError as exc:
         message = " ".join(_as_option(parser, args.command, exc).split())

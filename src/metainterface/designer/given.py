@@ -14,6 +14,7 @@ import numpy as np
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_file
+from metainterface._threads import uses_threads
 from metainterface.designer.curves import CURVE_STEPS, Curve, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
 from metainterface.physical.dimensions import physical_block
@@ -108,6 +109,7 @@ def as_design(
     return Design(gamma=gamma, h=h, settings=settings or CellSettings())
 
 
+@uses_threads()
 def curve(
     design: Design | str | os.PathLike[str] | None = None,
     *,
@@ -151,6 +153,7 @@ def curve(
     return design_curve(d, model, steps=steps, smooth=smooth, device=dev)
 
 
+@uses_threads()
 def export(
     design: Design | str | os.PathLike[str],
     path: str | os.PathLike[str],
@@ -275,6 +278,7 @@ def _designed_tiles(design: Any) -> tuple[int, int]:
     return n, n
 
 
+@uses_threads()
 def physical(
     design: Design,
     *,
@@ -291,6 +295,7 @@ def physical(
     return physical_block(as_design(design, None, None, None), **opts)
 
 
+@uses_threads()
 def pressure_check(
     design: Design, max_pressure: float | str, *, modulus: str | float | None = None
 ) -> PressureCheck:

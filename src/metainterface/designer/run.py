@@ -13,6 +13,7 @@ from typing import Any
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
+from metainterface._threads import uses_threads
 from metainterface.designer.curves import reach_note
 from metainterface.designer.given import _limit, _physical_options
 from metainterface.designer.options import Effort, Robust, Scale, merge
@@ -72,6 +73,7 @@ def _targets(targets: Target | str | Sequence[Target | str]) -> tuple[list[Targe
     return out, single
 
 
+@uses_threads()
 def design(
     targets: Target | str | Sequence[Target | str],
     *,
@@ -410,6 +412,7 @@ def _save_all(
             r.save(folder, full_target=full_target, **extra)
 
 
+@uses_threads()
 def compare(
     targets: Target | str | Sequence[Target | str],
     *,

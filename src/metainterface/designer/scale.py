@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import scale as _scale
 from metainterface.inverse.refine import RefineSettings
@@ -109,6 +110,7 @@ def _reference(law: Any, given: dict[str, float], var: str | None) -> dict[str, 
     return g
 
 
+@uses_threads()
 def feasible_scale(
     law: str | os.PathLike[str] | Any,
     *,
@@ -206,6 +208,7 @@ def _closer(values: np.ndarray, errors: np.ndarray) -> np.ndarray:
     return np.asarray(out, dtype=np.float64)
 
 
+@uses_threads()
 def design_scale(
     law: str | os.PathLike[str] | Any,
     *,

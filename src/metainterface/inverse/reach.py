@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError, UnreachableError
 from metainterface.inverse.targets import Target
 from metainterface.physical.friction import FrictionLaw, friction_target_in_units
@@ -15,6 +16,7 @@ from metainterface.physical.reach import reachability as _reachability
 from metainterface.physics.cell import CellSettings
 
 
+@uses_threads()
 def reachability(
     law: Target | FrictionLaw | str | os.PathLike[str],
     *,

@@ -12,6 +12,7 @@ import torch
 
 from metainterface import _checks
 from metainterface._device import resolve_device
+from metainterface._threads import uses_threads
 from metainterface.designer.results import DesignResult
 from metainterface.inverse import tolerance as tol
 from metainterface.inverse.perturb import Perturbation
@@ -83,6 +84,7 @@ class PrinterSizing:
         )
 
 
+@uses_threads()
 def min_radius(
     design: Design | DesignResult | str | os.PathLike[str],
     *,

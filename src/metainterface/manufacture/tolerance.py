@@ -20,6 +20,7 @@ import numpy as np
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import provenance, strict_json, write_columns, write_text
+from metainterface._threads import uses_threads
 from metainterface.designer.curves import ReachCounts, shown
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
@@ -279,6 +280,7 @@ _NAMES = {
 }
 
 
+@uses_threads()
 def tolerance(
     design: Design | DesignResult | str | os.PathLike[str],
     *,

@@ -13,6 +13,7 @@ import torch
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_file, check_output_folder
+from metainterface._threads import uses_threads
 from metainterface.data import generate_dataset as _generate
 from metainterface.data import load_dataset
 from metainterface.data.dataset import DEFAULT_CHUNK, GenerationReport
@@ -32,6 +33,7 @@ LAW_SEEDS = (1001, 1002)
 MAX_SAMPLES = 10_000_000
 
 
+@uses_threads("heavy")
 def generate_dataset(
     samples: int,
     out: str | os.PathLike[str],
@@ -61,6 +63,7 @@ def generate_dataset(
     return _generate(samples, seed, settings, out, progress=progress, chunk=chunk, device=dev)
 
 
+@uses_threads("heavy")
 def train_surrogate(
     dataset: str | os.PathLike[str],
     out: str | os.PathLike[str],
@@ -107,6 +110,7 @@ def train_surrogate(
     )
 
 
+@uses_threads("heavy")
 def evaluate_surrogate(
     dataset: str | os.PathLike[str],
     surrogate: str | os.PathLike[str] | None = None,

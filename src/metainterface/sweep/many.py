@@ -27,6 +27,7 @@ from metainterface._files import (
     write_text,
 )
 from metainterface._names import DEFAULT_ENGINE
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, require_xarray
 from metainterface.physics.cell import Design
@@ -189,6 +190,7 @@ def _write_summary(out: Path, rows: list[dict[str, Any]], **settings: Any) -> No
     write_text(out / "summary.csv", buf.getvalue())
 
 
+@uses_threads()
 def validate_many(
     designs: Sequence[str | os.PathLike[str] | Design] | str | os.PathLike[str],
     out_dir: str | os.PathLike[str],

@@ -37,6 +37,7 @@ from metainterface._files import (
     write_text,
 )
 from metainterface._names import DEFAULT_ENGINE
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, open_fields, require_xarray, write_fields
 from metainterface.physics.cell import Design
@@ -58,6 +59,7 @@ from metainterface.validation.validate import (
 )
 
 
+@uses_threads()
 def validate(
     design: Design | str | os.PathLike[str],
     *,
