@@ -74,7 +74,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import torch
-from scipy.special import erfc
 from torch import Tensor
 
 from metainterface.physics.cell import CellSettings
@@ -87,6 +86,13 @@ ITERATIONS = 2
 #: "Which terms"): it helps blunt cells, costs more, and makes identical asperities differ
 #: from the paper's model.
 CURVATURE = False
+
+
+def erfc(x: np.ndarray) -> np.ndarray:
+    """The complementary error function of an array, by torch, which is loaded already
+    (scipy.special costs a few tenths of a second to import, for this one function)."""
+    return torch.special.erfc(torch.as_tensor(x, dtype=torch.float64)).numpy()
+
 
 # Ewald splitting on the unit cell: beta = sqrt(pi) balances the two sums; 6 shells of
 # images and of wave vectors on each side reach float64 round-off at any point.
