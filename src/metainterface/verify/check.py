@@ -36,8 +36,8 @@ GRID_PER_ASPERITY = 128
 #: Default number of loads of the check.
 DEFAULT_LOADS = 10
 #: Polonsky-Keer-Rey tolerance of the check's solves. The check measures errors of a tenth
-#: of a per cent; at 1e-8 every alpha of the built-in targets' designs equals the 1e-11
-#: solve's (the paper's, ``mi.validate``'s default) to 1e-8 relative, in 40 % fewer
+#: of a per cent; at 1e-8 every alpha of the built-in targets' designs is the 1e-11
+#: solve's (the paper's, ``mi.validate``'s default) to 6e-8 relative, in 40 % fewer
 #: iterations (docs/concepts/verification.md).
 CHECK_TOLERANCE = 1e-8
 #: Loads a process of the check solves at least: every further process starts its chunk of
