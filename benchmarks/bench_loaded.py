@@ -75,7 +75,7 @@ COMMANDS = {
         "--out",
         "{tmp}/law",
     ],
-    "--help": ["--help"],
+    "help": ["--help"],
 }
 
 

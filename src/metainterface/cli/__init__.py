@@ -91,12 +91,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit status (2 for bad input, with a one-line message)."""
     import contextlib
 
+    parser = build_parser()
+    args = parser.parse_args(argv)  # --help and argument errors end here, before numpy loads
+
     from metainterface._files import output_set, terminate_as_interrupt
     from metainterface._threads import set_threads, threads_for
     from metainterface.runtime import tune_allocator
 
-    parser = build_parser()
-    args = parser.parse_args(argv)
     tune_allocator()
     if args.threads is not None:
         set_threads(args.threads)
