@@ -40,9 +40,10 @@ DEFAULT_LOADS = 10
 #: solve's (the paper's, ``mi.validate``'s default) to 6e-8 relative, in 40 % fewer
 #: iterations (docs/concepts/verification.md).
 CHECK_TOLERANCE = 1e-8
-#: Loads a process of the check solves at least: every further process starts its chunk of
-#: the path cold, which costs about as much as two warm-started loads.
-LOADS_PER_PROCESS = 4
+#: Loads a process of the check solves at least, so that starting it (a fork, the height
+#: map) stays small beside its solves. A chunk's cold first load cost no more than a
+#: warm-started one (saturating at 384^2: 0.46 s against 0.5-0.6 s).
+LOADS_PER_PROCESS = 2
 #: Most correction iterations (each is one BEM load path).
 MAX_ITERATIONS = 20
 #: The forward model the correction re-refines on by default: the interacting model, whose
