@@ -3,8 +3,9 @@
 Build (from the repository root): ``sphinx-build -W --keep-going -b html docs docs/_build/html``.
 Warnings are errors; the tutorials are executed on every build; the API reference is
 generated from ``metainterface.__all__`` (``_ext/metainterface_docs.py``). The build
-fetches nothing from the network (no intersphinx). The pages load MathJax from its CDN
-when they are viewed, as Sphinx does by default: opened offline, equations show as TeX.
+fetches nothing from the network (no intersphinx), and the pages load nothing from it
+either: math is rendered to MathML at build time (``_ext/mathml_render.py``), which the
+browser draws itself, so the pages read the same offline.
 """
 
 from __future__ import annotations
@@ -33,9 +34,10 @@ extensions = [
     "myst_nb",
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
-    "sphinx.ext.mathjax",
+    "mathml_render",
     "metainterface_docs",
 ]
+html_math_renderer = "mathml"
 
 exclude_patterns = ["_build", "figures/*.md", "**/.ipynb_checkpoints", "jupyter_execute"]
 templates_path: list[str] = []

@@ -31,6 +31,10 @@ def _sphinx(src: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
     return subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
 
 
+#: A script, style sheet or image a page would fetch from another host.
+_REMOTE = re.compile(r"<(?:script|link|img)\b[^>]*\b(?:src|href)=\"(?:https?:)?//[^\"]+\"")
+
+
 def _doc_comment(obj: object, name: str) -> str | None:
     """The ``#:`` comment of a module-level binding of ``obj`` to ``name`` in the package."""
     modules = [
@@ -71,6 +75,10 @@ def test_the_docs_build_warnings_free_with_every_tutorial_run(tmp_path):
         assert "cell_output" in page, f"{stem}: no cell outputs"
         for src in re.findall(r'<img[^>]+src="([^"]+\.png)"', page):
             assert (html / "tutorials" / src).resolve().is_file(), f"{stem}: {src} missing"
+    # no page loads anything from the network: offline, every page reads the same
+    for page in html.rglob("*.html"):
+        text = page.read_text(encoding="utf-8")
+        assert not _REMOTE.findall(text), f"{page.relative_to(html)}: {_REMOTE.findall(text)}"
     first = (html / "tutorials" / "first-design.html").read_text(encoding="utf-8")
     assert first.count("<img") >= 4  # the target, the full figure, the curves, the comparison
     # the reproduced figures page shows every PNG of docs/figures with its caption
@@ -85,6 +93,21 @@ def _project(tmp_path: Path, index: str) -> Path:
     src.mkdir()
     (src / "index.md").write_text(index, encoding="utf-8")
     return src
+
+
+def test_math_is_mathml_in_the_page_and_no_script_comes_from_the_network(tmp_path):
+    src = _project(
+        tmp_path,
+        "# Page\n\nInline $\\alpha = F_f / (\\tau A)$ and\n\n"
+        "$$\nP^* = \\frac{\\sum_i F_i}{A_\\mathrm{nom} E^*}\n$$\n",
+    )
+    done = _sphinx(src, tmp_path)
+    assert done.returncode == 0, done.stderr[-3000:]
+    page = (tmp_path / "html" / "index.html").read_text(encoding="utf-8")
+    assert page.count("<math") == 2 and "<mfrac>" in page  # drawn by the browser itself
+    assert "$" not in page.split("<body")[1].split("<footer")[0].replace("$$", "")
+    assert not _REMOTE.findall(page), _REMOTE.findall(page)
+    assert "mathjax" not in page.lower().replace("mathjax_ignore", "")
 
 
 def test_a_dead_cross_reference_fails_the_build(tmp_path):
