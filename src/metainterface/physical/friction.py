@@ -422,18 +422,19 @@ def friction_target_in_units(
 ) -> FrictionTarget:
     """:func:`friction_target` from quantities with units ('0.25MPa', '0.5mm', '4cm2') or
     numbers in SI. A bad quantity's error names its argument (``shear_strength``), or with
-    ``options`` the command-line option (``--shear-strength``)."""
+    ``options`` the command-line option (``--shear-strength``); a likely unit slip
+    (:mod:`.plausible`) warns."""
+    from metainterface.physical.plausible import warn_unit_slips
     from metainterface.physical.units import parse_area, parse_length, parse_pressure
 
     def name(arg: str) -> str:
         return "--" + arg.replace("_", "-") if options else arg
 
+    tau = parse_pressure(shear_strength, option=name("shear_strength"))
+    e_star = parse_pressure(modulus, option=name("modulus"))
+    r = parse_length(radius, option=name("radius"))
+    a = parse_area(area, option=name("area"))
+    warn_unit_slips(modulus=e_star, shear_strength=tau, radius=r)
     return friction_target(
-        law,
-        shear_strength=parse_pressure(shear_strength, option=name("shear_strength")),
-        e_star=parse_pressure(modulus, option=name("modulus")),
-        radius=parse_length(radius, option=name("radius")),
-        area=parse_area(area, option=name("area")),
-        settings=settings,
-        fit=fit,
+        law, shear_strength=tau, e_star=e_star, radius=r, area=a, settings=settings, fit=fit
     )
