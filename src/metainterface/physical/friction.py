@@ -7,7 +7,9 @@ whole tiled surface) and equivalent modulus E*:
     alpha = A_real / A = F_f / (tau A),      P* = F_n / (A E*).
 
 The curve comes from a CSV with a header and one row per load, in newtons:
-``normal_force,friction_force`` or ``normal_force,friction_coefficient`` (F_f = mu F_n).
+``normal_force,friction_force`` or ``normal_force,friction_coefficient`` (F_f = mu F_n); a
+header may give the force unit (``normal_force [mN]``), and the file may be separated by ';'
+or tabs with decimal commas (:func:`metainterface._files.columns.read_table`).
 With tau > 0, A_real and so F_f can only grow with the load: a friction force that decreases
 as the load increases, friction at zero load (adhesion is not modelled) or a real area larger
 than the nominal one is an error naming the row.
