@@ -40,6 +40,9 @@ LAB_FILES = {
     "semicolon_decimal_comma": _text("normal_force;friction_force", _forces(), sep=";", comma=True),
     "tab_decimal_comma": _text("normal_force\tfriction_force", _forces(), sep="\t", comma=True),
     "tab_points_mN": _text("normal_force [mN]\tfriction_force", _forces(1e-3), sep="\t"),
+    "trailing_separator": _text(
+        "normal_force;friction_force", _forces(), sep=";", comma=True
+    ).replace("\n", ";\n"),
     "comments_blanks": "# rig 3, 20 °C\n\n"
     + _text("normal_force,friction_force", _forces()).replace("\n", "\n\n", 3)
     + "# end\n",

@@ -113,7 +113,10 @@ def _split(path: Path, line: str, separator: str) -> list[str]:
         cells = next(csv.reader([line], delimiter=separator, skipinitialspace=True))
     except csv.Error as exc:
         raise MetainterfaceError(f"{path}: cannot split a line into cells ({exc})") from None
-    return [_cell(c) for c in cells]
+    cells = [_cell(c) for c in cells]
+    while len(cells) > 1 and not cells[-1]:  # a trailing separator, as some exports write
+        cells.pop()
+    return cells
 
 
 def header_name(cell: str, known: Sequence[str] = ()) -> tuple[str, str | None]:
