@@ -47,7 +47,7 @@ LAB_FILES = {
     + _text("normal_force,friction_force", _forces()).replace("\n", "\n\n", 3)
     + "# end\n",
     "coefficient_semicolon": _text(
-        "Normal_Force [mN];friction_coefficient",
+        "Normal_Force [mN];friction_coefficient [-]",
         list(zip(LOADS * 1e3, FRICTION / LOADS, strict=True)),
         sep=";",
         comma=True,

@@ -81,8 +81,9 @@ _NAME_UNIT = re.compile(r"^(.*?)\s*(?:\[([^\]]*)\]|\(([^)]*)\))$")
 @dataclass(frozen=True)
 class Table:
     """A numeric CSV as read: column names (lower case, inner blanks as '_'), each column's
-    unit text as written in the header (None without one), and the values (rows, columns).
-    rows: the 1-based data row of each value row (comment and blank lines not counted)."""
+    unit text as written in the header (None without one), the values (rows, columns) in
+    the order of the data rows (comment and blank lines not counted), and the separator's
+    name ('comma', 'semicolon', 'tab')."""
 
     path: Path
     names: list[str]
@@ -122,7 +123,8 @@ def _split(path: Path, line: str, separator: str) -> list[str]:
 def header_name(cell: str, known: Sequence[str] = ()) -> tuple[str, str | None]:
     """(name, unit) of a header cell: ``'Normal_Force [mN]'``, ``'normal_force (N)'`` or, for
     a name in ``known``, ``'normal_force_mN'`` give ('normal_force', 'mN'). The name is read
-    in lower case with inner blanks as '_'; the unit is kept as written (mN is not MN)."""
+    in lower case with inner blanks as '_'; the unit is kept as written (mN is not MN);
+    ``[-]``, ``[1]`` and ``[]`` mark no unit (None)."""
     cell = cell.strip()
     unit: str | None = None
     match = _NAME_UNIT.match(cell)
@@ -132,6 +134,8 @@ def header_name(cell: str, known: Sequence[str] = ()) -> tuple[str, str | None]:
             (match.group(2) if match.group(2) is not None else match.group(3)),
         )
         unit = unit.strip()
+        if unit in ("", "-", "1"):  # '[-]', '[1]': the usual marks of a dimensionless column
+            unit = None
     name = re.sub(r"\s+", "_", cell.strip()).lower()
     if unit is None:
         for k in known:
