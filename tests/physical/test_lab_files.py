@@ -43,6 +43,11 @@ LAB_FILES = {
     "trailing_separator": _text(
         "normal_force;friction_force", _forces(), sep=";", comma=True
     ).replace("\n", ";\n"),
+    "notes_column": "sample;normal_force;friction_force;note\n"
+    + "".join(
+        f"S{k};{n:.17g};{f:.17g};run {k}, dry\n".replace(".", ",")
+        for k, (n, f) in enumerate(_forces())
+    ),
     "comments_blanks": "# rig 3, 20 °C\n\n"
     + _text("normal_force,friction_force", _forces()).replace("\n", "\n\n", 3)
     + "# end\n",

@@ -161,14 +161,20 @@ def _number(path: Path, row: int, column: str, text: str, decimal_comma: bool) -
         ) from None
 
 
-def read_table(path: str | os.PathLike[str], known: Sequence[str] = ()) -> Table:
+def read_table(
+    path: str | os.PathLike[str],
+    known: Sequence[str] = (),
+    numeric: Sequence[str] | None = None,
+) -> Table:
     """Read a numeric CSV as labs and spreadsheets write it.
 
     The separator (tab, ';' or ',') is the first of them found in the header line; with ';'
     or tab, numbers may have a decimal comma ('1,5'), all of the file the same way. '#'
     lines and blank lines are skipped; a byte order mark is dropped. Header cells may carry
-    a unit (see :func:`header_name`; ``known`` names take one after '_'). Errors are one
-    line naming the file, the row (1-based data row) and the column.
+    a unit (see :func:`header_name`; ``known`` names take one after '_'). Only the columns
+    in ``numeric`` (default: all) are read as numbers, the others are NaN (a column of notes
+    is ignored). Errors are one line naming the file, the row (1-based data row) and the
+    column.
     """
     path = Path(path)
     lines = [ln for ln in read_text_lines(path) if ln.strip() and not ln.lstrip().startswith("#")]
@@ -195,9 +201,10 @@ def read_table(path: str | os.PathLike[str], known: Sequence[str] = ()) -> Table
             raise MetainterfaceError(
                 f"{path}: row {i} has {len(row)} values, the header has {len(names)}{hint}"
             )
-    decimal_comma = separator != "," and any("," in c for row in rows for c in row)
+    keep = [k for k, n in enumerate(names) if numeric is None or n in numeric]
+    decimal_comma = separator != "," and any("," in row[k] for row in rows for k in keep)
     for i, row in enumerate(rows, start=1):
-        for name, text in zip(names, row, strict=True):
+        for name, text in ((names[k], row[k]) for k in keep):
             if decimal_comma and "." in text and not text.lower().endswith(("inf", "nan")):
                 raise MetainterfaceError(
                     f"{path}: row {i}, column {name}: {text!r} has a decimal point in a file "
@@ -208,11 +215,10 @@ def read_table(path: str | os.PathLike[str], known: Sequence[str] = ()) -> Table
                     f"{path}: row {i}, column {name}: {text!r} is ambiguous (a decimal comma or "
                     f"a thousands separator?); write it with a decimal point"
                 )
-    values = [
-        [_number(path, i, n, t, decimal_comma) for n, t in zip(names, row, strict=True)]
-        for i, row in enumerate(rows, start=1)
-    ]
-    arr = np.asarray(values, dtype=np.float64).reshape(-1, len(names))
+    arr = np.full((len(rows), len(names)), np.nan)
+    for i, row in enumerate(rows, start=1):
+        for k in keep:
+            arr[i - 1, k] = _number(path, i, names[k], row[k], decimal_comma)
     return Table(path, names, [u for _, u in parsed], arr, SEPARATORS[separator])
 
 
@@ -222,7 +228,7 @@ def read_columns(path: str | os.PathLike[str], required: Sequence[str]) -> dict[
     Errors name the file, the row (1-based data row) and the column, or the missing column;
     a unit in the header of a required column is an error (these columns have none).
     """
-    table = read_table(path)
+    table = read_table(path, numeric=required)
     missing = [c for c in required if c not in table.names]
     if missing:
         raise MetainterfaceError(

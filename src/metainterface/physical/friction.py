@@ -82,7 +82,7 @@ def read_friction_csv(path: str | os.PathLike[str], *, check: bool = True) -> Fr
     order, repeats).
     """
     path = Path(path)
-    table = read_table(path, FRICTION_NAMES)
+    table = read_table(path, FRICTION_NAMES, numeric=FRICTION_NAMES)
     header = table.names
     if "friction_force" in header and "friction_coefficient" in header:
         raise MetainterfaceError(
