@@ -20,6 +20,7 @@ Targets and designs
 Designing
     design, compare, DesignResult, pressure_check, physical, reachability (can a cell
     follow this friction law at this E*, tau and area?), Reachability, UnreachableError,
+    UnitSlipWarning (a modulus, shear strength or radius that looks like a unit slip),
     feasible_scale (which area, E* or tau makes a friction law reachable, FeasibleScale),
     design_scale (a friction law designed with its area, E* or tau chosen too)
 Design options
@@ -101,6 +102,7 @@ _HOMES: dict[str, str] = {
     "feasible_scale": "metainterface.designer.scale",
     "MetainterfaceError": "metainterface.errors",
     "UnreachableError": "metainterface.errors",
+    "UnitSlipWarning": "metainterface.errors",
     "Reachability": "metainterface.physical.reach",
     "reachability": "metainterface.inverse.reach",
     "Target": "metainterface.inverse.targets",
@@ -130,7 +132,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.designer.run import compare, design
     from metainterface.designer.scale import design_scale, feasible_scale
     from metainterface.designer.view import view
-    from metainterface.errors import MetainterfaceError, UnreachableError
+    from metainterface.errors import MetainterfaceError, UnitSlipWarning, UnreachableError
     from metainterface.inverse.reach import reachability
     from metainterface.inverse.scale import FeasibleScale
     from metainterface.inverse.targets import Target
@@ -207,6 +209,7 @@ __all__ = [
     "Target",
     "ToleranceResult",
     "TrainConfig",
+    "UnitSlipWarning",
     "UnreachableError",
     "ValidationResult",
     "Verify",

@@ -27,3 +27,10 @@ class UnreachableError(MetainterfaceError):
         super().__init__(message)
         self.reachability = reachability
         self.target = target
+
+
+class UnitSlipWarning(UserWarning):
+    """A modulus, shear strength or radius that reads as a quantity but is almost surely in
+    the wrong unit (``modulus=2.4`` is 2.4 Pa, not 2.4 MPa). The message names the value and
+    what was probably meant; silence it with ``warnings.filterwarnings("ignore",
+    category=mi.UnitSlipWarning)`` where such a value is meant."""

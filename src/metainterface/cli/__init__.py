@@ -12,10 +12,12 @@ not ``starts``). SIGTERM and SIGHUP end a run like Ctrl-C (exit 130), temporarie
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import sys
-from collections.abc import Sequence
-from typing import NoReturn
+import warnings
+from collections.abc import Iterator, Sequence
+from typing import Any, NoReturn
 
 from metainterface.cli.common import positive_int
 from metainterface.errors import MetainterfaceError
@@ -89,8 +91,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit status (2 for bad input, with a one-line message)."""
-    import contextlib
-
     parser = build_parser()
     args = parser.parse_args(argv)  # --help and argument errors end here, before numpy loads
 
@@ -104,7 +104,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     whole = output_set() if args.command in ALL_OR_NOTHING else contextlib.nullcontext()
     work = "heavy" if args.command in HEAVY else "light"
     try:
-        with terminate_as_interrupt(), whole, threads_for(work):
+        with terminate_as_interrupt(), whole, threads_for(work), _unit_slips_in_one_line(args):
             return int(args.func(args) or 0)
     except MetainterfaceError as exc:
         message = " ".join(_as_option(parser, args.command, exc).split())
@@ -116,6 +116,29 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"metainterface {args.command}: interrupted", file=sys.stderr)
         return 130
+
+
+@contextlib.contextmanager
+def _unit_slips_in_one_line(args: argparse.Namespace) -> Iterator[None]:
+    """Show each unit-slip warning (``--modulus 2.4`` read as 2.4 Pa) once, as one line on
+    stderr: ``metainterface design: warning: modulus 2.4 Pa is below 1 kPa: ...``. The same
+    value is checked on every path that reads it (the law, its feasible scale, the design)."""
+    from metainterface.errors import UnitSlipWarning
+
+    shown: set[str] = set()
+    default = warnings.showwarning
+
+    def show(message: Any, category: type, *rest: Any, **kw: Any) -> None:
+        if not issubclass(category, UnitSlipWarning):
+            default(message, category, *rest, **kw)
+        elif str(message) not in shown:
+            shown.add(str(message))
+            print(f"metainterface {args.command}: warning: {message}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", UnitSlipWarning)
+        warnings.showwarning = show
+        yield
 
 
 def _as_option(parser: argparse.ArgumentParser, command: str, exc: MetainterfaceError) -> str:

@@ -41,12 +41,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="append",
         default=[],
         metavar="FILE",
-        help="CSV with header p_star,alpha",
+        help="CSV with header p_star,alpha (comma, ';' or tab; decimal commas with ';')",
     )
     src.add_argument(
         "--friction-csv",
         metavar="FILE",
-        help="CSV normal_force,friction_force [N] (or normal_force,friction_coefficient)"
+        help="CSV normal_force,friction_force [N] (or normal_force,friction_coefficient; units "
+        "in the header, e.g. 'normal_force [mN]'; comma, ';' or tab)"
         "; needs --shear-strength --modulus --radius --area",
     )
     src.add_argument(

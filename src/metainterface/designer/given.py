@@ -18,6 +18,7 @@ from metainterface._threads import uses_threads
 from metainterface.designer.curves import CURVE_STEPS, Curve, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
 from metainterface.physical.dimensions import physical_block
+from metainterface.physical.plausible import warn_unit_slips
 from metainterface.physical.units import (
     parse_area,
     parse_force,
@@ -69,9 +70,12 @@ def _physical_options(radius: Any, modulus: Any, total_force: Any, area: Any) ->
         return None
     if total_force is not None and area is not None:
         raise MetainterfaceError("give total_force or area, not both")
+    r = _physical("radius", parse_length(radius, option="radius"))
+    e_star = _physical("modulus", parse_pressure(modulus, option="modulus"))
+    warn_unit_slips(modulus=e_star, radius=r)
     return {
-        "radius": _physical("radius", parse_length(radius, option="radius")),
-        "e_star": _physical("modulus", parse_pressure(modulus, option="modulus")),
+        "radius": r,
+        "e_star": e_star,
         "total_force": None
         if total_force is None
         else _physical("total_force", parse_force(total_force, option="total_force")),
@@ -213,6 +217,7 @@ def export(
         resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
     radius_m = parse_length(radius, option="radius")
     _physical("radius", radius_m)
+    warn_unit_slips(radius=radius_m)
     source = str(design) if isinstance(design, str | os.PathLike) else None
     step = None
     if z_step is not None:

@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from metainterface._threads import uses_threads
-from metainterface.errors import MetainterfaceError
+from metainterface.errors import MetainterfaceError, UnitSlipWarning
 from metainterface.inverse import scale as _scale
 from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
@@ -67,6 +68,7 @@ def _law_and_scale(
 ) -> tuple[Any, Any, dict[str, float], str | None, tuple[float, float] | None]:
     """(law, fit, given SI scale, the variable left free or None, its bounds)."""
     from metainterface.physical.friction import prepare_law
+    from metainterface.physical.plausible import warn_unit_slips
     from metainterface.physical.units import parse_length
 
     values = {"area": area, "modulus": modulus, "shear_strength": shear_strength}
@@ -88,6 +90,9 @@ def _law_and_scale(
         given[var] = math.sqrt(span[0] * span[1]) if span else math.nan
     law, lf = prepare_law(law, fit)
     given["radius"] = parse_length(radius, option="radius")
+    warn_unit_slips(
+        **{k: given[k] for k in ("modulus", "shear_strength", "radius") if k != var},
+    )
     return law, lf, given, var, span
 
 
@@ -321,7 +326,9 @@ def design_scale(
     phys = {"modulus": at["modulus"], "radius": at["radius"]}
     if "total_force" not in options:
         phys["area"] = at["area"]
-    return design(t, settings=settings, **phys, **options)
+    with warnings.catch_warnings():  # a unit slip was said once, above
+        warnings.simplefilter("ignore", UnitSlipWarning)
+        return design(t, settings=settings, **phys, **options)
 
 
 def scale_line(result: Any) -> str | None:

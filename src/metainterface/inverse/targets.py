@@ -118,7 +118,8 @@ class Target:
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str], name: str | None = None) -> Target:
-        """A target from a CSV with header ``p_star,alpha`` ('#' lines are skipped)."""
+        """A target from a CSV with header ``p_star,alpha`` ('#' lines and blank lines are
+        skipped; comma, ';' or tab separated, decimal commas with ';' or tab)."""
         return target_from_csv(path, name)
 
     @classmethod
@@ -135,7 +136,10 @@ class Target:
         fit: str = "auto",
     ) -> Target:
         """A target from a friction law: a CSV ``normal_force,friction_force`` [N] (or
-        ``normal_force,friction_coefficient``), one row per load.
+        ``normal_force,friction_coefficient``), one row per load; the header may give the
+        force unit (``normal_force [mN]``, ``friction_force_kN``), the file ';' or tab
+        separators and decimal commas. A likely unit slip in the scale (E* below 1 kPa,
+        tau above E*, R above 10 cm) warns (:class:`~metainterface.UnitSlipWarning`).
 
         shear_strength tau, modulus E*, radius R, area (nominal area of the whole interface):
         quantities with units ('0.25MPa', '0.5mm', '4cm2') or numbers in SI. Bowden-Tabor:

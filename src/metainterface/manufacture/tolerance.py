@@ -27,6 +27,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.inverse import tolerance as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
 from metainterface.inverse.targets import Target
+from metainterface.physical.plausible import warn_unit_slips
 from metainterface.physical.printer import length_in_r
 from metainterface.physical.units import parse_pressure, parse_quantity
 from metainterface.physics.cell import Design
@@ -354,6 +355,8 @@ def tolerance(
     s_s = _checks.number(names["scale_sigma"], scale_sigma, low=0.0, high=0.5)
     tau = _stress(shear_strength, d, ("shear_strength_pa",), names["shear_strength"])
     e_star = _stress(modulus, d, ("e_star_pa",), names["modulus"])
+    if (radius, modulus, shear_strength) != (None, None, None):  # the user's scale: slips?
+        warn_unit_slips(modulus=e_star, shear_strength=tau, radius=r_m)
     dev = resolve_device(device)
     t0 = time.perf_counter()
     pert = Perturbation.draw(

@@ -7,7 +7,9 @@ whole tiled surface) and equivalent modulus E*:
     alpha = A_real / A = F_f / (tau A),      P* = F_n / (A E*).
 
 The curve comes from a CSV with a header and one row per load, in newtons:
-``normal_force,friction_force`` or ``normal_force,friction_coefficient`` (F_f = mu F_n).
+``normal_force,friction_force`` or ``normal_force,friction_coefficient`` (F_f = mu F_n); a
+header may give the force unit (``normal_force [mN]``), and the file may be separated by ';'
+or tabs with decimal commas (:func:`metainterface._files.columns.read_table`).
 With tau > 0, A_real and so F_f can only grow with the load: a friction force that decreases
 as the load increases, friction at zero load (adhesion is not modelled) or a real area larger
 than the nominal one is an error naming the row.
@@ -23,14 +25,12 @@ from typing import Any
 
 import numpy as np
 
-from metainterface._files.columns import read_columns, read_text_lines
+from metainterface._files.columns import Table, read_table
 from metainterface._names import FIT_NAMES
 from metainterface.errors import MetainterfaceError
 from metainterface.physical._lawfit import LawFit, fit_law
 from metainterface.physics.cell import CellSettings
 
-FORCE_COLUMNS = ("normal_force", "friction_force")
-COEFFICIENT_COLUMNS = ("normal_force", "friction_coefficient")
 #: Points a target needs (the design command's minimum), the added origin included.
 MIN_POINTS = 3
 #: When the measured rows are replaced by a monotone fit (:mod:`._lawfit`): "auto" fits
@@ -58,41 +58,57 @@ class FrictionLaw:
     source: str = "friction law"
 
 
-def _header(path: Path) -> list[str]:
-    for line in read_text_lines(path):
-        if line.strip() and not line.lstrip().startswith("#"):
-            return [c.strip().strip('"').strip() for c in line.split(",")]
-    return []
+#: Column names of a friction CSV (each may carry a unit in its header: ``normal_force [mN]``).
+FRICTION_NAMES = ("normal_force", "friction_force", "friction_coefficient")
+
+
+def _forces(table: Table, name: str) -> np.ndarray:
+    """A force column in newtons, converted from the unit its header gives (none: N)."""
+    from metainterface.physical.units import force_unit
+
+    unit = table.unit(name)
+    where = f"{table.path}: column {name}" + ("" if unit is None else f" [{unit}]")
+    return table.column(name) * force_unit(unit, where=where)
 
 
 def read_friction_csv(path: str | os.PathLike[str], *, check: bool = True) -> FrictionLaw:
     """Read a friction curve: ``normal_force,friction_force`` or ``...,friction_coefficient``.
 
-    Forces in newtons, the coefficient dimensionless. Every value finite and >= 0; with
-    ``check`` also the rows as a law (normal force strictly increasing, friction never
-    decreasing, no friction at zero load), else the rows as measured (any order, repeats).
+    Forces in newtons unless the header gives a unit (``normal_force [mN]``,
+    ``friction_force (kN)``, ``normal_force_uN``: any force unit pint reads); the coefficient
+    dimensionless. Separators, decimal commas, comments: :func:`read_table`. Every value finite
+    and >= 0; with ``check`` also the rows as a law (normal force strictly increasing,
+    friction never decreasing, no friction at zero load), else the rows as measured (any
+    order, repeats).
     """
     path = Path(path)
-    header = _header(path)
+    table = read_table(path, FRICTION_NAMES, numeric=FRICTION_NAMES)
+    header = table.names
     if "friction_force" in header and "friction_coefficient" in header:
         raise MetainterfaceError(
             f"{path}: both friction_force and friction_coefficient columns; keep one "
             "(they could disagree, and one would be ignored)"
         )
-    if "friction_force" in header:
-        cols = read_columns(path, FORCE_COLUMNS)
-        friction = cols["friction_force"]
-    elif "friction_coefficient" in header:
-        cols = read_columns(path, COEFFICIENT_COLUMNS)
-        _check_values(path, "friction_coefficient", cols["friction_coefficient"])
-        friction = cols["friction_coefficient"] * cols["normal_force"]
-    else:
+    if "normal_force" not in header or not {"friction_force", "friction_coefficient"} & set(header):
         raise MetainterfaceError(
-            f"{path}: the header must be normal_force,friction_force (N) or "
+            f"{path}: missing column(s); the header must be normal_force,friction_force (N) or "
             f"normal_force,friction_coefficient (found {','.join(header) or 'nothing'})"
         )
+    normal = _forces(table, "normal_force")
+    if "friction_force" in header:
+        friction = _forces(table, "friction_force")
+    else:
+        unit = table.unit("friction_coefficient")
+        if unit is not None:
+            raise MetainterfaceError(
+                f"{path}: column friction_coefficient [{unit}]: a friction coefficient is "
+                f"dimensionless, write it without a unit"
+            )
+        mu = table.column("friction_coefficient")
+        _check_values(path, "friction_coefficient", mu)
+        friction = mu * normal
     law = FrictionLaw(
-        normal_force=cols["normal_force"],
+        normal_force=normal,
         friction_force=friction,
         rows=np.arange(1, friction.size + 1),
         source=str(path),
@@ -408,18 +424,19 @@ def friction_target_in_units(
 ) -> FrictionTarget:
     """:func:`friction_target` from quantities with units ('0.25MPa', '0.5mm', '4cm2') or
     numbers in SI. A bad quantity's error names its argument (``shear_strength``), or with
-    ``options`` the command-line option (``--shear-strength``)."""
+    ``options`` the command-line option (``--shear-strength``); a likely unit slip
+    (:mod:`.plausible`) warns."""
+    from metainterface.physical.plausible import warn_unit_slips
     from metainterface.physical.units import parse_area, parse_length, parse_pressure
 
     def name(arg: str) -> str:
         return "--" + arg.replace("_", "-") if options else arg
 
+    tau = parse_pressure(shear_strength, option=name("shear_strength"))
+    e_star = parse_pressure(modulus, option=name("modulus"))
+    r = parse_length(radius, option=name("radius"))
+    a = parse_area(area, option=name("area"))
+    warn_unit_slips(modulus=e_star, shear_strength=tau, radius=r)
     return friction_target(
-        law,
-        shear_strength=parse_pressure(shear_strength, option=name("shear_strength")),
-        e_star=parse_pressure(modulus, option=name("modulus")),
-        radius=parse_length(radius, option=name("radius")),
-        area=parse_area(area, option=name("area")),
-        settings=settings,
-        fit=fit,
+        law, shear_strength=tau, e_star=e_star, radius=r, area=a, settings=settings, fit=fit
     )

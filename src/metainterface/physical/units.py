@@ -127,6 +127,31 @@ def parse_force(value: str | float, *, option: str = "force") -> float:
     return parse_quantity(value, "force", option=option)
 
 
+#: Force units named in messages about a force column's unit (pint reads any other too).
+FORCE_UNITS = "N, mN, kN, µN (or uN)"
+
+
+def force_unit(unit: str | None, *, where: str) -> float:
+    """Newtons per ``unit``, a force unit as a CSV header writes it ('mN', 'kN', 'µN', 'uN';
+    None or '' is N). where: the file and column, for the one-line error on a unit that
+    pint does not know or that is not a force."""
+    if unit is None or not unit.strip():
+        return 1.0
+    text = unit.strip()
+    ureg = _registry()
+    try:
+        quantity = ureg.Quantity(1.0, ureg.parse_units(_UNIT_POWER.sub(r"\1**\2", text)))
+    except Exception:  # pint's parser raises many types on malformed text
+        raise MetainterfaceError(
+            f"{where}: unknown unit {text!r}; a force column takes {FORCE_UNITS}"
+        ) from None
+    if not quantity.check(DIMENSIONS["force"][0]):
+        raise MetainterfaceError(
+            f"{where}: {text!r} is not a force unit; a force column takes {FORCE_UNITS}"
+        )
+    return float(quantity.to("N").magnitude)
+
+
 def parse_pressure_limit(
     value: str | float,
     *,
