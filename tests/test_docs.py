@@ -79,8 +79,8 @@ first = {"command-line": 0, "design-space": 1}
 for page in sorted(pages, key=lambda p: (first.get(p.stem, 2), -p.stat().st_size)):
     cache.add_nb_to_project(str(page), read_data={"name": "myst_nb_md", "type": "plugin"})
 run = load_executor("local-parallel", cache).run_and_cache(timeout=300)
-for pk in run.errored + run.excepted:
-    print(cache.get_project_record(pk).uri, cache.get_project_record(pk).traceback)
+for uri in run.errored + run.excepted:
+    print(uri, cache.get_project_record(uri).traceback)
 print("executed", len(run.succeeded), "of", len(pages))
 sys.exit(1 if run.errored or run.excepted or len(run.succeeded) != len(pages) else 0)
 """
