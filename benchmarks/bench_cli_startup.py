@@ -21,7 +21,12 @@ CASES = {
     "metainterface design --help": ["-m", "metainterface", "design", "--help"],
     "metainterface design --bogus (error)": ["-m", "metainterface", "design", "--bogus"],
     "metainterface validate --grid -5 (error)": [
-        "-m", "metainterface", "validate", "x.json", "--grid", "-5",
+        "-m",
+        "metainterface",
+        "validate",
+        "x.json",
+        "--grid",
+        "-5",
     ],
     "import torch (for scale)": ["-c", "import torch"],
 }

@@ -13,8 +13,7 @@ HEAVY = ("torch", "scipy.stats", "matplotlib", "pint")
 def _imported_after(code: str) -> set[str]:
     """Heavy modules imported by ``code`` in a fresh interpreter."""
     probe = (
-        f"import sys\n{code}\n"
-        f"print('HEAVY:' + ','.join(m for m in {HEAVY!r} if m in sys.modules))"
+        f"import sys\n{code}\nprint('HEAVY:' + ','.join(m for m in {HEAVY!r} if m in sys.modules))"
     )
     out = subprocess.run(
         [sys.executable, "-c", probe], capture_output=True, text=True, check=True
