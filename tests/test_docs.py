@@ -2,7 +2,8 @@
 
 The full build runs the tutorials (about two CPU-minutes), so it is the longest test of the
 fast suite; it is in it on purpose: a broken example, a public name without a docstring or a
-dead cross-reference fails the test command, not a later docs deployment.
+dead cross-reference fails the test command, not a later docs deployment. Its notebooks run
+side by side, one per core, before the build (``_EXECUTE``), which takes their outputs.
 """
 
 from __future__ import annotations
@@ -62,8 +63,47 @@ def test_every_public_name_has_a_docstring(name):
     assert len(doc.strip()) > 20, f"metainterface.{name} has no docstring"
 
 
+# Run in a fresh interpreter: the kernels get the environment docs/conf.py gives them in a
+# sphinx-build, then every notebook page is executed into a jupyter-cache, as many at a time
+# as there are cores, the longest first (the command line's, then training one, then the
+# others in order of size: a proxy, only the order depends on it).
+_EXECUTE = """
+import runpy, sys
+from pathlib import Path
+from jupyter_cache import get_cache
+from jupyter_cache.executors import load_executor
+
+docs, cache = Path(sys.argv[1]), get_cache(sys.argv[2])
+runpy.run_path(str(docs / "conf.py"))
+pages = [
+    p for p in docs.rglob("*.md")
+    if "_build" not in p.parts and "file_format: mystnb" in p.read_text("utf-8")
+]
+first = {"command-line": 0, "design-space": 1}
+for page in sorted(pages, key=lambda p: (first.get(p.stem, 2), -p.stat().st_size)):
+    cache.add_nb_to_project(str(page), read_data={"name": "myst_nb_md", "type": "plugin"})
+run = load_executor("local-parallel", cache).run_and_cache(timeout=300)
+for uri in run.errored + run.excepted:
+    print(uri, cache.get_project_record(uri).traceback)
+print("executed", len(run.succeeded), "of", len(pages))
+sys.exit(1 if run.errored or run.excepted or len(run.succeeded) != len(pages) else 0)
+"""
+
+
 def test_the_docs_build_warnings_free_with_every_tutorial_run(tmp_path):
-    done = _sphinx(DOCS, tmp_path)
+    # The notebooks run first, in parallel, into a cache under the build folder; the build
+    # takes their outputs from it (nb_execution_mode "cache": a page whose code is not in the
+    # cache, as it ran, is executed by the build itself).
+    cache = tmp_path / "jupyter_cache"
+    ran = subprocess.run(
+        [sys.executable, "-c", _EXECUTE, str(DOCS), str(cache)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert ran.returncode == 0, ran.stdout[-6000:] + ran.stderr[-3000:]
+    mode = ["-D", "nb_execution_mode=cache", "-D", f"nb_execution_cache_path={cache}"]
+    done = _sphinx(DOCS, tmp_path, *mode)
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-6000:]
     html = tmp_path / "html"
     # every public name has its reference page, generated from __all__

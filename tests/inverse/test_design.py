@@ -12,7 +12,8 @@ from metainterface.inverse.refine import RefineSettings
 from metainterface.physics import CellSettings
 
 S = CellSettings()
-FAST = RefineSettings(stages=3, steps_per_stage=2, iterations=20)
+# a short polish too: the tests check what each option does, not the last digits of a design
+FAST = RefineSettings(stages=3, steps_per_stage=2, iterations=20, polish_iterations=30)
 
 
 def test_batched_lbfgs_rows_are_independent():

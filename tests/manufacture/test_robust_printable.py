@@ -12,7 +12,9 @@ DMAX = 0.02
 
 
 def test_z_step_puts_heights_on_the_grid_and_reports_the_cost(tmp_path):
-    r = mi.design("bilinear", z_step="1um", radius="0.5mm", out=tmp_path, verify=False)
+    r = mi.design(
+        "bilinear", z_step="1um", radius="0.5mm", out=tmp_path, verify=False, hedge=2, fallback=0
+    )
     step = 1e-6 / 0.5e-3
     levels = r.design.h / step
     np.testing.assert_allclose(levels, np.round(levels), atol=1e-9)
@@ -65,10 +67,19 @@ def test_export_on_the_layer_grid(tmp_path):
 
 def test_robust_design_reports_both_and_lowers_the_made_error(tmp_path):
     kw = dict(sigma_h=0.1 * DMAX, sigma_gamma=0.05)
+    # both designs with the same short search (no fallback multistart): the comparison is
+    # robust against nominal, not of search efforts
+    quick = mi.Effort(hedge=2, fallback=0)
     rob = mi.design(
-        "saturating", robust=True, robust_samples=8, out=tmp_path / "r", verify=False, **kw
+        "saturating",
+        robust=True,
+        robust_samples=8,
+        out=tmp_path / "r",
+        verify=False,
+        effort=quick,
+        **kw,
     )
-    nom = mi.design("saturating", out=tmp_path / "n", verify=False)
+    nom = mi.design("saturating", out=tmp_path / "n", verify=False, effort=quick)
     s = rob.robust
     assert s["error_nominal"] == rob.error and s["sigma_h"] == pytest.approx(0.1 * DMAX)
     assert 0 < s["error_median"] <= s["error_p95"]
