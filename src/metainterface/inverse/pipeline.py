@@ -146,9 +146,13 @@ def design(
     if notes:
         warnings.warn(notes[0], stacklevel=2)
         hedge = fallback = 0
-    results = _design(targets, method, hedge=0, **common)
-    if method == "surrogate" and hedge > 0:
-        results = _hedged(results, targets, hedge, hedge_error, common)
+    zero_shot = None
+    if method == "surrogate" and hedge > 0:  # made once, for the design and its hedges
+        points = (refine_settings or RefineSettings()).grid_points
+        zero_shot = _zero_shot(targets, model_path, model, points)
+    results = _design(targets, method, hedge=0, zero_shot=zero_shot, **common)
+    if zero_shot is not None:
+        results = _hedged(results, targets, hedge, hedge_error, zero_shot, common)
     if notes:
         results = [replace(r, notes=notes) for r in results]
     missed = [i for i, r in enumerate(results) if r.error > fallback_error]
@@ -186,17 +190,26 @@ def _hedged(
     targets: Sequence[Target],
     hedge: int,
     hedge_error: float,
+    zero_shot: tuple[Tensor, Tensor, list[str]],
     common: dict,
 ) -> list[DesignResult]:
     """The results with the ``hedge`` starts refined for the targets that the zero-shot
     design missed by more than ``hedge_error`` (by :func:`_score`), in one batch; each of
     those keeps the better of its zero-shot and its best hedge design (``start`` 1..hedge
-    when a hedge wins)."""
+    when a hedge wins). ``zero_shot``: the targets' zero-shot designs (:func:`_zero_shot`),
+    which the jittered hedge starts copy."""
     missed = [i for i, r in enumerate(results) if _score(r) > hedge_error]
     if not missed:
         return results
+    gamma0, h0, labels = zero_shot
+    rows = torch.tensor(missed)
     alt = _design(
-        [targets[i] for i in missed], "surrogate", hedge=hedge, hedges_only=True, **common
+        [targets[i] for i in missed],
+        "surrogate",
+        hedge=hedge,
+        hedges_only=True,
+        zero_shot=(gamma0[rows], h0[rows], [labels[i] for i in missed]),
+        **common,
     )
     out = list(results)
     for i, a in zip(missed, alt, strict=True):
@@ -296,11 +309,13 @@ def _design(
     perturb: Perturbation | None = None,
     device: torch.device | None = None,
     hedges_only: bool = False,
+    zero_shot: tuple[Tensor, Tensor, list[str]] | None = None,
 ) -> list[DesignResult]:
     """One batch of starts per target, refined, the best kept. The surrogate's rows per
     target: its zero-shot design and ``hedge`` hedge starts, or (``hedges_only``) the hedge
     starts alone, numbered 1..hedge in ``start`` as they would be beside the zero-shot row
-    (whose refinement the caller has)."""
+    (whose refinement the caller has). ``zero_shot``: the surrogate's designs of the
+    targets as :func:`_zero_shot` makes them, if the caller has them."""
     dev = device or torch.device("cpu")
     if method not in METHODS:
         raise MetainterfaceError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
@@ -313,13 +328,10 @@ def _design(
     if method == "surrogate":
         from metainterface.surrogate.checkpoint import default_model_path, design_model
 
-        net, model_settings, _ = design_model(model_path or default_model_path())
-        settings = model_settings
-        gamma0, h0 = predict(net, targets, settings)
-        laws_net = shipped_laws_net(model_path, settings, targets)
-        gamma0, h0, zero_shot_from = best_views(
-            net, targets, gamma0, h0, settings, model, refine_settings.grid_points, laws_net
-        )
+        settings = design_model(model_path or default_model_path())[1]
+        if zero_shot is None:
+            zero_shot = _zero_shot(targets, model_path, model, refine_settings.grid_points)
+        gamma0, h0, zero_shot_from = zero_shot
         per_target = 1 + max(hedge, 0)
         if hedge > 0 and hedges_only:  # rows per target: [hedge starts]
             g_r, h_r = hedge_starts(gamma0, h0, hedge, settings, seed)
@@ -409,6 +421,22 @@ def _design(
         )
         for i, (t, b) in enumerate(zip(targets, best.tolist(), strict=True))
     ]
+
+
+def _zero_shot(
+    targets: Sequence[Target],
+    model_path: str | os.PathLike[str] | None,
+    model: ForwardModel,
+    points: int,
+) -> tuple[Tensor, Tensor, list[str]]:
+    """The surrogate's zero-shot designs gamma0, h0 (T, N) of the targets, each the best of
+    its views (:func:`best_views`, on ``points`` pressures), and where each comes from."""
+    from metainterface.surrogate.checkpoint import default_model_path, design_model
+
+    net, settings, _ = design_model(model_path or default_model_path())
+    gamma0, h0 = predict(net, targets, settings)
+    laws_net = shipped_laws_net(model_path, settings, targets)
+    return best_views(net, targets, gamma0, h0, settings, model, points, laws_net)
 
 
 def _usable_method(
