@@ -33,6 +33,7 @@ from metainterface.inverse.params import (
 )
 from metainterface.inverse.perturb import Perturbation
 from metainterface.inverse.refine import (
+    HEDGE_ERROR,
     RefineSettings,
     TargetGrid,
     polish,
@@ -59,13 +60,6 @@ METHODS: dict[str, Parameterisation] = dict(zip(METHOD_NAMES, (FULL, FULL, HERTZ
 
 #: Rows polished per target (the best by error after the stages), the winner picked after.
 POLISH_ROWS = 3
-
-#: The hedge starts run only for targets whose refined zero-shot design misses them by more
-#: than this relative curve error (the robust one when designing for it): a design already
-#: within it gains nothing that matters from more starts (ten times the design tolerance
-#: RefineSettings.tol_error, far below the BEM's accuracy), and the hedges cost several
-#: times the design (benchmarks/bench_design_speed.py).
-HEDGE_ERROR = 1e-4
 
 
 def design(
@@ -97,6 +91,8 @@ def design(
     paper's pipeline. The hedges run after it, and only for the targets whose refined
     zero-shot design misses them by more than ``hedge_error`` (relative curve error, the
     robust one with ``perturb``): a design within it has nothing to gain that matters.
+    ``hedge_error`` 0 refines the hedges with the zero-shot row in one batch, cheaper where
+    every target needs them (a scale search's candidates).
 
     ``fallback`` (surrogate method only): a target whose refined design still misses it by
     more than ``fallback_error`` (relative curve error) is far from anything the surrogate
@@ -150,8 +146,10 @@ def design(
     if method == "surrogate" and hedge > 0:  # made once, for the design and its hedges
         points = (refine_settings or RefineSettings()).grid_points
         zero_shot = _zero_shot(targets, model_path, model, points)
-    results = _design(targets, method, hedge=0, zero_shot=zero_shot, **common)
-    if zero_shot is not None:
+    gate = zero_shot is not None and hedge_error > 0
+    # hedge_error 0: the zero-shot row and the hedges in one batch (where all need them)
+    results = _design(targets, method, hedge=0 if gate else hedge, zero_shot=zero_shot, **common)
+    if gate:
         results = _hedged(results, targets, hedge, hedge_error, zero_shot, common)
     if notes:
         results = [replace(r, notes=notes) for r in results]

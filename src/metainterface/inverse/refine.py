@@ -33,6 +33,13 @@ from metainterface.physics.pressures import at_delta, solve_delta
 
 POLISH_METHODS = ("levmar", "lbfgs")
 
+#: The hedge starts run only for targets whose refined zero-shot design misses them by more
+#: than this relative curve error (the robust one when designing for it): a design already
+#: within it gains nothing that matters from more starts (ten times the design tolerance
+#: RefineSettings.tol_error, far below the BEM's accuracy), and the hedges cost several
+#: times the design (benchmarks/bench_design_speed.py).
+HEDGE_ERROR = 1e-4
+
 
 @dataclass(frozen=True)
 class RefineSettings:
