@@ -17,12 +17,16 @@ Run: python benchmarks/bench_design_speed.py [--repeats 5] [--batch 100] [--prof
 import argparse
 import cProfile
 import pstats
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import torch
 
 import metainterface as mi
+
+sys.path.insert(0, str(Path(__file__).parent))
 from bench_design import realisable_targets
 
 torch.set_num_threads(1)  # one core, before any design runs
