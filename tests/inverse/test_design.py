@@ -96,6 +96,31 @@ def test_hedge_starts_are_refined_with_the_zero_shot_one():
     assert hedged.error < 0.05
 
 
+def test_hedges_run_only_where_the_zero_shot_design_misses(monkeypatch):
+    from metainterface.inverse import pipeline
+
+    t = [builtin_target("saturating"), builtin_target("linear")]
+    pure = design(t, "surrogate", refine_settings=FAST)
+    batches = []
+    real = pipeline._design
+
+    def spy(targets, *args, **kw):
+        batches.append(([x.name for x in targets], kw["hedge"], kw.get("hedges_only", False)))
+        return real(targets, *args, **kw)
+
+    monkeypatch.setattr(pipeline, "_design", spy)
+    # saturating's refined prediction is within 1 %, linear's is not
+    gated = design(t, "surrogate", hedge=3, refine_settings=FAST, hedge_error=0.01)
+    assert pure[0].error < 0.01 < pure[1].error
+    assert batches == [(["saturating", "linear"], 0, False), (["linear"], 3, True)]
+    assert gated[0].error == pure[0].error and gated[0].start == 0
+    assert gated[1].error <= pure[1].error and 0 <= gated[1].start <= 3
+    assert gated[1].initial_error == pure[1].initial_error  # the zero-shot row's
+    batches.clear()
+    design(t, "surrogate", hedge=3, refine_settings=FAST, hedge_error=0.0)
+    assert batches == [(["saturating", "linear"], 3, False)]  # one batch, as all need them
+
+
 def test_fallback_multistart_for_targets_the_surrogate_misses():
     # an exactly linear law is far from every training curve: the surrogate's refined design
     # misses it, so the fallback multistart runs and the better design is kept

@@ -13,7 +13,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from metainterface.errors import MetainterfaceError
-from metainterface.inverse.refine import RefineSettings
+from metainterface.inverse.refine import HEDGE_ERROR, RefineSettings
 
 
 @dataclass(frozen=True)
@@ -112,6 +112,11 @@ class Effort:
     refine_settings : RefineSettings or None
         The refinement's stages, iterations and tolerances (default: the paper's 5 stages x
         5 steps x 20 iterations, then the polish); fewer make a quicker, rougher design.
+    hedge_error : float
+        Surrogate method: the hedge starts are refined (after the prediction's own design)
+        only for targets that design misses by more than this relative curve error
+        (default 1e-4: a design within it gains nothing that matters from more starts);
+        0 refines them with the prediction in one batch, for every target.
 
     Examples
     --------
@@ -127,6 +132,7 @@ class Effort:
     refine: bool = True
     seed: int = 0
     refine_settings: RefineSettings | None = None
+    hedge_error: float = HEDGE_ERROR
 
 
 #: The keyword of :func:`~metainterface.design` that each group's field stands for (where

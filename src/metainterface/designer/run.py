@@ -185,6 +185,7 @@ def design(
         knobs["seed"],
     )
     refine_settings = knobs["refine_settings"]
+    hedge_error = knobs["hedge_error"]
     size = merge(
         scale,
         Scale,
@@ -222,6 +223,12 @@ def design(
     hedge = _checks.whole("hedge", hedge, low=0, high=MAX_STARTS)
     fallback = _checks.whole("fallback", fallback, low=0, high=MAX_STARTS)
     seed = _checks.whole("seed", seed, low=0, high=MAX_SEED)
+    if isinstance(hedge_error, bool) or not (
+        isinstance(hedge_error, int | float) and 0 <= hedge_error < float("inf")
+    ):
+        raise MetainterfaceError(
+            f"hedge_error must be a number >= 0, got {hedge_error!r}", argument="effort"
+        )
     n = (settings or CellSettings()).n_asperities
     dev = resolve_device(device)
     if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
@@ -269,6 +276,7 @@ def design(
         refine_settings=refine_settings,
         hedge=hedge if method == "surrogate" else 0,
         fallback=fallback if method == "surrogate" else 0,
+        hedge_error=float(hedge_error),
         perturb=perturb,
         z_step=step,
         device=dev,

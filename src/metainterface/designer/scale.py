@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from metainterface._threads import uses_threads
+from metainterface.designer.options import Effort
 from metainterface.errors import MetainterfaceError, UnitSlipWarning
 from metainterface.inverse import scale as _scale
 from metainterface.inverse.refine import RefineSettings
@@ -282,13 +283,22 @@ def design_scale(
         )
 
     quick_opts = {k: v for k, v in options.items() if k in ("method", "seed", "model", "hedge")}
+    effort = Effort(
+        hedge=Effort.hedge if quick_opts.get("hedge") is None else quick_opts["hedge"],
+        seed=Effort.seed if quick_opts.get("seed") is None else quick_opts["seed"],
+        fallback=0,
+        refine_settings=QUICK,
+        # a candidate's design is rarely within Effort.hedge_error: its hedges are refined
+        # with its prediction in one batch, not after it
+        hedge_error=0.0,
+    )
+    quick_opts = {k: v for k, v in quick_opts.items() if k in ("method", "model")}
 
     def quick(vals: np.ndarray) -> np.ndarray:
         made = design(
             [target(v, f"{stem}-{i}") for i, v in enumerate(vals)],
             settings=settings,
-            refine_settings=QUICK,
-            fallback=0,
+            effort=effort,
             verify=False,  # candidates are ranked on the model; the chosen one is checked
             **quick_opts,
         )

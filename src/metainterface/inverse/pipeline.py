@@ -33,6 +33,7 @@ from metainterface.inverse.params import (
 )
 from metainterface.inverse.perturb import Perturbation
 from metainterface.inverse.refine import (
+    HEDGE_ERROR,
     RefineSettings,
     TargetGrid,
     polish,
@@ -76,6 +77,7 @@ def design(
     hedge: int = 0,
     fallback: int = 0,
     fallback_error: float = 0.02,
+    hedge_error: float = HEDGE_ERROR,
     perturb: Perturbation | None = None,
     z_step: float | None = None,
     device: str | torch.device = "cpu",
@@ -86,7 +88,11 @@ def design(
     prediction (:func:`hedge_starts`: jittered copies of it, which find better neighbouring
     optima, and random starts, a guard for targets far from the training distribution such
     as exactly linear laws) and keep the best, at the cost of a larger batch. 0 is the
-    paper's pipeline.
+    paper's pipeline. The hedges run after it, and only for the targets whose refined
+    zero-shot design misses them by more than ``hedge_error`` (relative curve error, the
+    robust one with ``perturb``): a design within it has nothing to gain that matters.
+    ``hedge_error`` 0 refines the hedges with the zero-shot row in one batch, cheaper where
+    every target needs them (a scale search's candidates).
 
     ``fallback`` (surrogate method only): a target whose refined design still misses it by
     more than ``fallback_error`` (relative curve error) is far from anything the surrogate
@@ -136,7 +142,15 @@ def design(
     if notes:
         warnings.warn(notes[0], stacklevel=2)
         hedge = fallback = 0
-    results = _design(targets, method, hedge=hedge, **common)
+    zero_shot = None
+    if method == "surrogate" and hedge > 0:  # made once, for the design and its hedges
+        points = (refine_settings or RefineSettings()).grid_points
+        zero_shot = _zero_shot(targets, model_path, model, points)
+    gate = zero_shot is not None and hedge_error > 0
+    # hedge_error 0: the zero-shot row and the hedges in one batch (where all need them)
+    results = _design(targets, method, hedge=0 if gate else hedge, zero_shot=zero_shot, **common)
+    if gate:
+        results = _hedged(results, targets, hedge, hedge_error, zero_shot, common)
     if notes:
         results = [replace(r, notes=notes) for r in results]
     missed = [i for i, r in enumerate(results) if r.error > fallback_error]
@@ -167,6 +181,43 @@ def design(
             results, z_step, refine_settings or RefineSettings(), extra_loss, model, perturb, dev
         )
     return results
+
+
+def _hedged(
+    results: list[DesignResult],
+    targets: Sequence[Target],
+    hedge: int,
+    hedge_error: float,
+    zero_shot: tuple[Tensor, Tensor, list[str]],
+    common: dict,
+) -> list[DesignResult]:
+    """The results with the ``hedge`` starts refined for the targets that the zero-shot
+    design missed by more than ``hedge_error`` (by :func:`_score`), in one batch; each of
+    those keeps the better of its zero-shot and its best hedge design (``start`` 1..hedge
+    when a hedge wins). ``zero_shot``: the targets' zero-shot designs (:func:`_zero_shot`),
+    which the jittered hedge starts copy."""
+    missed = [i for i, r in enumerate(results) if _score(r) > hedge_error]
+    if not missed:
+        return results
+    gamma0, h0, labels = zero_shot
+    rows = torch.tensor(missed)
+    alt = _design(
+        [targets[i] for i in missed],
+        "surrogate",
+        hedge=hedge,
+        hedges_only=True,
+        zero_shot=(gamma0[rows], h0[rows], [labels[i] for i in missed]),
+        **common,
+    )
+    out = list(results)
+    for i, a in zip(missed, alt, strict=True):
+        r = results[i]
+        if _score(a) < _score(r):
+            r = replace(
+                r, gamma=a.gamma, h=a.h, error=a.error, robust_error=a.robust_error, start=a.start
+            )
+        out[i] = replace(r, seconds=r.seconds + a.seconds)
+    return out
 
 
 def _score(r: DesignResult) -> float:
@@ -255,7 +306,14 @@ def _design(
     hedge: int,
     perturb: Perturbation | None = None,
     device: torch.device | None = None,
+    hedges_only: bool = False,
+    zero_shot: tuple[Tensor, Tensor, list[str]] | None = None,
 ) -> list[DesignResult]:
+    """One batch of starts per target, refined, the best kept. The surrogate's rows per
+    target: its zero-shot design and ``hedge`` hedge starts, or (``hedges_only``) the hedge
+    starts alone, numbered 1..hedge in ``start`` as they would be beside the zero-shot row
+    (whose refinement the caller has). ``zero_shot``: the surrogate's designs of the
+    targets as :func:`_zero_shot` makes them, if the caller has them."""
     dev = device or torch.device("cpu")
     if method not in METHODS:
         raise MetainterfaceError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
@@ -266,17 +324,17 @@ def _design(
     refine_settings = refine_settings or RefineSettings()
     t0 = time.perf_counter()
     if method == "surrogate":
-        from metainterface.surrogate.checkpoint import default_model_path, load_model
+        from metainterface.surrogate.checkpoint import default_model_path, design_model
 
-        net, model_settings, _ = load_model(model_path or default_model_path())
-        settings = model_settings
-        gamma0, h0 = predict(net, targets, settings)
-        laws_net = shipped_laws_net(model_path, settings, targets)
-        gamma0, h0, zero_shot_from = best_views(
-            net, targets, gamma0, h0, settings, model, refine_settings.grid_points, laws_net
-        )
+        settings = design_model(model_path or default_model_path())[1]
+        if zero_shot is None:
+            zero_shot = _zero_shot(targets, model_path, model, refine_settings.grid_points)
+        gamma0, h0, zero_shot_from = zero_shot
         per_target = 1 + max(hedge, 0)
-        if hedge > 0:  # rows per target: [zero-shot, hedge starts]
+        if hedge > 0 and hedges_only:  # rows per target: [hedge starts]
+            g_r, h_r = hedge_starts(gamma0, h0, hedge, settings, seed)
+            gamma0, h0, per_target = g_r.flatten(0, 1), h_r.flatten(0, 1), hedge
+        elif hedge > 0:  # rows per target: [zero-shot, hedge starts]
             g_r, h_r = hedge_starts(gamma0, h0, hedge, settings, seed)
             gamma0 = torch.cat([gamma0[:, None], g_r], 1).flatten(0, 1)
             h0 = torch.cat([h0[:, None], h_r], 1).flatten(0, 1)
@@ -355,12 +413,28 @@ def _design(
             initial_error=float(first[i]),
             settings=settings,
             model=model,
-            start=int(winner[i]),
+            start=int(winner[i]) + int(hedges_only),
             robust_error=None if perturb is None else float(rank[b]),
             zero_shot_from=zero_shot_from[i],
         )
         for i, (t, b) in enumerate(zip(targets, best.tolist(), strict=True))
     ]
+
+
+def _zero_shot(
+    targets: Sequence[Target],
+    model_path: str | os.PathLike[str] | None,
+    model: ForwardModel,
+    points: int,
+) -> tuple[Tensor, Tensor, list[str]]:
+    """The surrogate's zero-shot designs gamma0, h0 (T, N) of the targets, each the best of
+    its views (:func:`best_views`, on ``points`` pressures), and where each comes from."""
+    from metainterface.surrogate.checkpoint import default_model_path, design_model
+
+    net, settings, _ = design_model(model_path or default_model_path())
+    gamma0, h0 = predict(net, targets, settings)
+    laws_net = shipped_laws_net(model_path, settings, targets)
+    return best_views(net, targets, gamma0, h0, settings, model, points, laws_net)
 
 
 def _usable_method(
@@ -372,10 +446,10 @@ def _usable_method(
     multistart, with a note saying why."""
     if method != "surrogate" or settings is None:
         return method, ()
-    from metainterface.surrogate.checkpoint import default_model_path, load_model
+    from metainterface.surrogate.checkpoint import default_model_path, design_model
 
     path = model_path or default_model_path()
-    _, trained, _ = load_model(path)
+    _, trained, _ = design_model(path)
     if settings.with_(n_steps=trained.n_steps) == trained:
         return method, ()
     mine = {k: v for k, v in settings.to_dict().items() if trained.to_dict()[k] != v}

@@ -188,14 +188,14 @@ def shipped_laws_net(
     from metainterface.surrogate.checkpoint import (
         default_laws_model_path,
         default_model_path,
-        load_model,
+        design_model,
     )
 
     shipped = model_path is None or Path(model_path).resolve() == default_model_path().resolve()
     path = default_laws_model_path()
     if not shipped or not path.is_file() or all(t.stiffness is not None for t in targets):
         return None
-    net, trained, _ = load_model(path)
+    net, trained, _ = design_model(path)
     return net if trained == settings else None
 
 

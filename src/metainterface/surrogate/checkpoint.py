@@ -6,6 +6,7 @@ architecture, training summary, package version); nothing is ever unpickled.
 
 from __future__ import annotations
 
+import functools
 import io
 import os
 from pathlib import Path
@@ -79,6 +80,26 @@ def load_model(path: str | os.PathLike[str]) -> tuple[InverseMLP, CellSettings, 
         raise MetainterfaceError(f"model {path}: inconsistent weights file ({exc})") from None
     model.eval()
     return model, settings, config
+
+
+def design_model(path: str | os.PathLike[str]) -> tuple[InverseMLP, CellSettings, dict[str, Any]]:
+    """:func:`load_model` for designing, read once per file version: the same (model,
+    settings, config) back while the file's path, size and modification time stay the
+    same (a design used to spend ~10 ms reading the weights at every call). The model is
+    shared: read it, never change it (``predict`` works on a copy)."""
+    path = Path(path).resolve()
+    try:
+        st = path.stat()
+    except OSError:
+        return load_model(path)  # the one-line error of a missing file
+    return _design_model(path, st.st_size, st.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=4)
+def _design_model(
+    path: Path, size: int, mtime_ns: int
+) -> tuple[InverseMLP, CellSettings, dict[str, Any]]:
+    return load_model(path)
 
 
 def default_model_path() -> Path:
