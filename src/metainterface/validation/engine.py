@@ -15,11 +15,10 @@ up to ``retries`` times, and replaces a broken local pool that it owns.
 from __future__ import annotations
 
 import concurrent.futures as cf
-import contextlib
 import multiprocessing as mp
 import os
 import sys
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,6 +28,7 @@ from metainterface._process import die_with_parent
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.validation.bem import LoadPath, solve_path
+from metainterface.validation.engines import torch_threads
 from metainterface.validation.heightmap import height_map
 
 #: Times a task the engine lost (a dead worker, a broken pool) is submitted again.
@@ -54,24 +54,12 @@ class BemTask:
     threads: int | None = 1
 
 
-@contextlib.contextmanager
-def _one_torch_thread() -> Iterator[None]:
-    """torch on one thread for the block, then as it was. A worker forked (by our pool or a
-    user's) after its parent used torch's OpenMP threads hangs in its first torch operation
-    on several threads; the height map is the only torch a task runs."""
-    import torch
-
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(threads)
-
-
 def solve_task(task: BemTask) -> LoadPath:
     """Run one task (in a worker): height map, then the warm-started load path."""
-    with _one_torch_thread():
+    # A worker forked (by our pool or a user's) after its parent used torch's OpenMP threads
+    # hangs in its first torch operation on several threads; the height map is the only
+    # torch a task runs before the solve, which sets its own threads.
+    with torch_threads(1):
         hm = height_map(task.design, task.grid)
     return solve_path(
         hm.heights,
