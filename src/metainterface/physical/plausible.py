@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import warnings
+from collections.abc import Callable
 
 from metainterface.errors import UnitSlipWarning
 
@@ -35,6 +36,16 @@ def _shown(value: float, unit: str) -> str:
     return f"{value:g} {unit}" if 0.01 <= value < 1000 else _si(value, unit, space=True)
 
 
+def _meant(value: float, factor: float, done: Callable[[float], bool]) -> float:
+    """``value`` times ``factor`` (1e3 or 1e-3: one SI prefix) until ``done``: what a slipped
+    value probably meant. At most 12 prefixes, so a zero or an infinity cannot loop."""
+    for _ in range(12):
+        if done(value):
+            break
+        value *= factor
+    return value
+
+
 def unit_slips(
     *,
     modulus: float | None = None,
@@ -48,34 +59,26 @@ def unit_slips(
     low, high = MODULUS_RANGE
     modulus_ok = True
     if modulus is not None and modulus < low:
-        meant = modulus
-        while meant < _TYPICAL_MODULUS:
-            meant *= 1e3
+        meant = _meant(modulus, 1e3, lambda v: v >= _TYPICAL_MODULUS)
         out.append(
             f"modulus {_shown(modulus, 'Pa')} is below 1 kPa: a unit slip? ({_si(meant, 'Pa')})"
         )
         modulus_ok = False
     elif modulus is not None and modulus > high:
-        meant = modulus
-        while meant > high:
-            meant /= 1e3
+        meant = _meant(modulus, 1e-3, lambda v: v <= high)
         out.append(
             f"modulus {_shown(modulus, 'Pa')} is above 1 TPa: a unit slip? ({_si(meant, 'Pa')})"
         )
         modulus_ok = False
     too_strong = modulus is not None and shear_strength is not None and shear_strength > modulus
     if modulus_ok and too_strong:
-        meant = shear_strength
-        while meant > modulus:
-            meant /= 1e3
+        meant = _meant(shear_strength, 1e-3, lambda v: v <= modulus)
         out.append(
             f"shear strength {_shown(shear_strength, 'Pa')} is above the modulus "
             f"{_shown(modulus, 'Pa')}: a unit slip? ({_si(meant, 'Pa')})"
         )
     if radius is not None and radius > RADIUS_MAX:
-        meant = radius
-        while meant > RADIUS_MAX:
-            meant /= 1e3
+        meant = _meant(radius, 1e-3, lambda v: v <= RADIUS_MAX)
         out.append(
             f"radius {_shown(radius, 'm')} is above 10 cm: a unit slip? ({meant * 1e3:.4g}mm)"
         )
