@@ -6,6 +6,9 @@ machine without a GPU). Run them alone with ``pytest -m cuda tests/test_cuda.py`
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from dataclasses import replace
 
 import numpy as np
@@ -30,6 +33,8 @@ def test_auto_is_cuda():
     from metainterface._device import resolve_device
 
     assert resolve_device("auto").type == "cuda"
+    # a design's refinement is launch-bound on a GPU: "auto" keeps it on the CPU
+    assert resolve_device("auto", small=True).type == "cpu"
 
 
 def test_dataset_on_cuda_matches_cpu(tmp_path):
@@ -72,8 +77,34 @@ def test_cpu_and_cuda_runs_of_one_seed_are_each_repeatable(tmp_path):
         )
         losses.append(run.best_val_loss)
     # atomic adds in CUDA's scatter and index backward passes make a run repeatable to
-    # rounding there, not bit for bit (docs/concepts/devices.md)
-    assert losses[0] == pytest.approx(losses[1], rel=1e-3)
+    # rounding there, not bit for bit (docs/concepts/devices.md); two epochs amplify that
+    # rounding to a few 1e-4 of the loss (4.7e-4 on an H200)
+    assert losses[0] == pytest.approx(losses[1], rel=1e-2)
+
+
+def test_cuda_training_is_bitwise_repeatable_with_deterministic_algorithms(tmp_path):
+    """What docs/concepts/devices.md tells a user who needs bit-for-bit runs on a GPU."""
+    mi.generate_dataset(600, tmp_path / "d.npz", seed=1, progress=False, device="cpu")
+    script = (
+        "import sys, torch, metainterface as mi\n"
+        "from metainterface.surrogate.train import TrainConfig\n"
+        "torch.use_deterministic_algorithms(True)\n"
+        "cfg = TrainConfig(epochs=2, batch_size=64, physics_steps=32)\n"
+        "r = mi.train_surrogate(sys.argv[1], sys.argv[2], cfg, progress=False, device='cuda')\n"
+        "print(repr(r.best_val_loss))\n"
+    )
+    env = {**os.environ, "CUBLAS_WORKSPACE_CONFIG": ":4096:8"}
+    out = [
+        subprocess.run(
+            [sys.executable, "-c", script, str(tmp_path / "d.npz"), str(tmp_path / f"r{i}")],
+            env=env,
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.split()[-1]
+        for i in range(2)
+    ]
+    assert out[0] == out[1]
 
 
 @pytest.mark.parametrize("method", ["surrogate", "multistart"])

@@ -11,6 +11,9 @@ def test_auto_is_cuda_only_when_torch_sees_it():
     expected = "cuda" if torch.cuda.is_available() else "cpu"
     assert resolve_device("auto").type == expected
     assert resolve_device().type == expected
+    # small work (a design's refinement) stays on the CPU under "auto", on any machine
+    assert resolve_device("auto", small=True).type == "cpu"
+    assert resolve_device("cpu", small=True).type == "cpu"
 
 
 def test_cpu_and_torch_device_pass_through():

@@ -17,12 +17,17 @@ if TYPE_CHECKING:  # torch is imported only when a device is resolved
 DEVICES = ("auto", "cpu", "cuda")
 
 
-def resolve_device(device: Any = "auto", *, name: str = "device") -> torch.device:
+def resolve_device(
+    device: Any = "auto", *, name: str = "device", small: bool = False
+) -> torch.device:
     """The torch device for ``device``.
 
-    "auto" takes the first CUDA device when torch sees one, else the CPU; "cpu"; "cuda" or
-    "cuda:N" (refused, in one line, when torch sees no such device); a ``torch.device`` as is.
-    Raises MetainterfaceError naming ``name`` and the allowed values on anything else.
+    "auto" takes the first CUDA device when torch sees one, else the CPU, except for
+    ``small`` work, which "auto" keeps on the CPU: a design's refinement is thousands of
+    small sequential steps on a few rows, bound by kernel-launch latency on a GPU
+    (``benchmarks/results/devices.md``). "cpu"; "cuda" or "cuda:N" (refused, in one line,
+    when torch sees no such device); a ``torch.device`` as is. Raises MetainterfaceError
+    naming ``name`` and the allowed values on anything else.
     """
     import torch
 
@@ -35,7 +40,7 @@ def resolve_device(device: Any = "auto", *, name: str = "device") -> torch.devic
             f"{name} must be one of {', '.join(DEVICES)} or cuda:N, got {device!r}", argument=name
         )
     if text == "auto":
-        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+        return torch.device("cuda" if torch.cuda.is_available() and not small else "cpu")
     if text == "cpu":
         return torch.device("cpu")
     if text == "cuda" or text.startswith("cuda:"):

@@ -33,5 +33,6 @@ def add_device(parser: argparse.ArgumentParser) -> None:
         "--device",
         default="auto",
         metavar="DEVICE",
-        help="auto, cpu, cuda or cuda:N (default auto: CUDA when torch sees it, else the CPU)",
+        help="auto, cpu, cuda or cuda:N (default auto: CUDA when torch sees it, but a design's "
+        "refinement on the CPU, faster there)",
     )

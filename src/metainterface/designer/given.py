@@ -153,7 +153,7 @@ def curve(
     steps = _checks.whole("steps", steps, low=2, high=MAX_STEPS)
     if smooth is not None:
         smooth = _checks.number("smooth", smooth, low=SMOOTH_RANGE[0], high=SMOOTH_RANGE[1])
-    dev = resolve_device(device)
+    dev = resolve_device(device, small=True)
     return design_curve(d, model, steps=steps, smooth=smooth, device=dev)
 
 

@@ -146,7 +146,9 @@ def design(
         Design a friction law no cell can follow anyway (the closest cell, ``result.forced``);
         without it such a target raises :class:`~metainterface.UnreachableError`.
     device : str
-        ``"auto"`` (CUDA when torch sees it), ``"cpu"``, ``"cuda"`` or ``"cuda:N"``.
+        ``"auto"``, ``"cpu"``, ``"cuda"`` or ``"cuda:N"``. "auto" refines on the CPU (faster
+        than a GPU for a design's small steps) and runs the BEM check on CUDA when torch
+        sees it.
     out : path
         Write each result's files here (several targets: ``out/<name>``).
     full_target, meta
@@ -230,7 +232,7 @@ def design(
             f"hedge_error must be a number >= 0, got {hedge_error!r}", argument="effort"
         )
     n = (settings or CellSettings()).n_asperities
-    dev = resolve_device(device)
+    dev = resolve_device(device, small=True)
     if refine_settings is not None and not isinstance(refine_settings, RefineSettings):
         raise MetainterfaceError("refine_settings must be a RefineSettings")
     if not isinstance(refine, bool):

@@ -134,7 +134,7 @@ def min_radius(
     budget = _max_error(max_error, names["max_error"])
     s_g = _checks.number(names["sigma_gamma"], sigma_gamma, low=0.0)
     s_s = _checks.number(names["scale_sigma"], scale_sigma, low=0.0, high=0.5)
-    dev = resolve_device(device)
+    dev = resolve_device(device, small=True)
     pert = Perturbation.draw(
         d.n_asperities, samples, seed, sigma_h=0.0, sigma_gamma=s_g, scale_sigma=s_s
     )
