@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 import metainterface as mi
-from metainterface.physical.friction import FrictionLaw, friction_target_in_units
+from metainterface.units.friction import FrictionLaw, friction_target_in_units
 
 sys.path.insert(0, str(Path(__file__).parent))
 

@@ -16,7 +16,7 @@ from importlib.resources import files
 from pathlib import Path
 
 import metainterface as mi
-from metainterface.validation.engine import local_pool, stream
+from metainterface.validation.executors import local_pool, stream
 
 
 def family(folder: Path, n: int) -> list[Path]:
@@ -86,7 +86,7 @@ def main() -> None:
         ):
             ex = client.get_executor(pure=False)
             # workers import the package once before the clock starts
-            client.run(__import__, "metainterface.validation.engine")
+            client.run(__import__, "metainterface.validation.executors")
             warm = sweep(paths, root / "dask2", g, k, executor=ex)
             rows.append(
                 (f"Dask, {args.workers} running workers (executor=)", warm, os.getloadavg()[0])

@@ -69,7 +69,7 @@ def test_every_public_name_is_listed_and_resolves():
 
 def test_a_subpackage_never_hides_a_public_function():
     code = (
-        "import metainterface as mi, metainterface.physical.units\n"
+        "import metainterface as mi, metainterface.units.quantities\n"
         "mi.design\n"
         "print(callable(mi.physical) and not isinstance(mi.physical, type(mi)))"
     )

@@ -95,15 +95,15 @@ _HOMES: dict[str, str] = {
     "validate_many": "metainterface.sweep.many",
     "view": "metainterface.designer.view",
     "write_result": "metainterface.sweep.validate",
-    "design_scale": "metainterface.designer.scale",
+    "design_scale": "metainterface.scaling.choose",
     "Effort": "metainterface.designer.options",
     "Robust": "metainterface.designer.options",
     "Scale": "metainterface.designer.options",
-    "feasible_scale": "metainterface.designer.scale",
+    "feasible_scale": "metainterface.scaling.choose",
     "MetainterfaceError": "metainterface.errors",
     "UnreachableError": "metainterface.errors",
     "UnitSlipWarning": "metainterface.errors",
-    "Reachability": "metainterface.physical.reach",
+    "Reachability": "metainterface.units.reach",
     "reachability": "metainterface.inverse.reach",
     "Target": "metainterface.inverse.targets",
     "CellSettings": "metainterface.physics.cell",
@@ -118,7 +118,7 @@ _HOMES: dict[str, str] = {
     "set_threads": "metainterface._threads",
     "TrainConfig": "metainterface.surrogate.train",
     "ValidationResult": "metainterface.validation.result",
-    "FeasibleScale": "metainterface.inverse.scale",
+    "FeasibleScale": "metainterface.scaling.search",
     "BemCheck": "metainterface.verify.check",
     "Verify": "metainterface.verify.check",
 }
@@ -130,15 +130,12 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.designer.options import Effort, Robust, Scale
     from metainterface.designer.results import DesignResult
     from metainterface.designer.run import compare, design
-    from metainterface.designer.scale import design_scale, feasible_scale
     from metainterface.designer.view import view
     from metainterface.errors import MetainterfaceError, UnitSlipWarning, UnreachableError
     from metainterface.inverse.reach import reachability
-    from metainterface.inverse.scale import FeasibleScale
     from metainterface.inverse.targets import Target
     from metainterface.manufacture.sizing import PrinterSizing, min_radius
     from metainterface.manufacture.tolerance import ToleranceResult, tolerance
-    from metainterface.physical.reach import Reachability
     from metainterface.physics.cell import CellSettings, Design
     from metainterface.physics.models import (
         MODELS,
@@ -149,10 +146,13 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         register_model,
     )
     from metainterface.runtime import tune_allocator
+    from metainterface.scaling.choose import design_scale, feasible_scale
+    from metainterface.scaling.search import FeasibleScale
     from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
     from metainterface.surrogate.train import TrainConfig
     from metainterface.sweep.many import validate_many
     from metainterface.sweep.validate import validate, write_result
+    from metainterface.units.reach import Reachability
     from metainterface.validation.result import ValidationResult
     from metainterface.verify.check import BemCheck, Verify
 

@@ -18,5 +18,5 @@ EXPORT_FORMATS: tuple[str, ...] = ("stl", "png", "tiff", "npy")
 #: The BEM contact solvers (``validation.engines.ENGINES``), and the default one.
 ENGINE_NAMES: tuple[str, ...] = ("torch", "tamaas")
 DEFAULT_ENGINE = "torch"
-#: When a friction law's rows are replaced by a monotone fit (``physical.friction.FIT_CHOICES``).
+#: When a friction law's rows are replaced by a monotone fit (``units.friction.FIT_CHOICES``).
 FIT_NAMES: tuple[str, ...] = ("auto", "always", "never")

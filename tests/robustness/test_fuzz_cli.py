@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from robust_helpers import SLOW_EXAMPLES, assert_refused
 
 import metainterface as mi
-from metainterface.physical import parse_length
+from metainterface.units import parse_length
 
 BIG = str(2**70)
 

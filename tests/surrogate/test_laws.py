@@ -13,7 +13,6 @@ from metainterface.cli import main
 from metainterface.data import load_dataset
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.reseed import RESEED_FLOOR, RESEED_SLACK
-from metainterface.physical.friction import FrictionLaw, friction_target, friction_target_in_units
 from metainterface.physics import CellSettings
 from metainterface.physics.curves import normalised_from_points
 from metainterface.physics.pressures import alpha_at
@@ -24,6 +23,7 @@ from metainterface.surrogate.checkpoint import (
 )
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.laws import KINDS, LawTargets, law_split
+from metainterface.units.friction import FrictionLaw, friction_target, friction_target_in_units
 
 S = CellSettings()
 TAU, E_STAR, RADIUS, AREA = 0.25e6, 2e6, 0.5e-3, 4e-4

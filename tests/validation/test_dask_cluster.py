@@ -114,7 +114,7 @@ class Cluster:
         with distributed.Client(self.address, timeout=30, set_as_default=False) as client:
             client.wait_for_workers(workers, timeout=60)
             # every worker imports the package once, side by side
-            client.run(importlib.import_module, "metainterface.validation.engine")
+            client.run(importlib.import_module, "metainterface.validation.executors")
 
     def close(self) -> None:
         for proc in reversed(self.procs):

@@ -31,8 +31,8 @@ def verify(args: argparse.Namespace):
 def manufacturing(args: argparse.Namespace) -> dict:
     """The robust-design and layer options, lengths in units of R (errors name the options)."""
     import metainterface as mi
-    from metainterface.physical import parse_length
-    from metainterface.physical.printer import layer_step, length_in_r
+    from metainterface.units import parse_length
+    from metainterface.units.printer import layer_step, length_in_r
 
     radius = None if args.radius is None else parse_length(args.radius, option="--radius")
     out: dict = {}

@@ -225,7 +225,7 @@ def _targets(args: argparse.Namespace) -> list:
     targets += [mi.Target.from_csv(f) for f in args.target_csv]
     if args.friction_csv and not _scale_free(args):
         from metainterface.inverse.targets import friction_law_target
-        from metainterface.physical.friction import friction_target_from_options
+        from metainterface.units.friction import friction_target_from_options
 
         ft = friction_target_from_options(
             args.friction_csv,
@@ -275,7 +275,7 @@ def _advise(args: argparse.Namespace, name: str) -> None:
 def _design_scale(args: argparse.Namespace, options: dict) -> list:
     """--friction-csv with a free area, modulus or shear strength: the scale designed too."""
     import metainterface as mi
-    from metainterface.designer.scale import scale_line
+    from metainterface.scaling.choose import scale_line
 
     if args.target or args.target_csv or args.compare:
         raise mi.MetainterfaceError(

@@ -64,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     import metainterface as mi
-    from metainterface.physical import parse_length
+    from metainterface.units import parse_length
 
     resolution = None
     if args.resolution is not None:

@@ -17,18 +17,18 @@ from metainterface._files import check_output_file
 from metainterface._threads import uses_threads
 from metainterface.designer.curves import CURVE_STEPS, Curve, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
-from metainterface.physical.dimensions import physical_block
-from metainterface.physical.plausible import warn_unit_slips
-from metainterface.physical.units import (
+from metainterface.physics.cell import CellSettings, Design
+from metainterface.physics.limits import PressureCheck, check_pressure
+from metainterface.physics.models import ForwardModel
+from metainterface.units.dimensions import physical_block
+from metainterface.units.plausible import warn_unit_slips
+from metainterface.units.quantities import (
     parse_area,
     parse_force,
     parse_length,
     parse_pressure,
     parse_pressure_limit,
 )
-from metainterface.physics.cell import CellSettings, Design
-from metainterface.physics.limits import PressureCheck, check_pressure
-from metainterface.physics.models import ForwardModel
 
 #: Most points of a curve (a sane run time).
 MAX_STEPS = 1_000_000
@@ -221,7 +221,7 @@ def export(
     source = str(design) if isinstance(design, str | os.PathLike) else None
     step = None
     if z_step is not None:
-        from metainterface.physical.printer import layer_step
+        from metainterface.units.printer import layer_step
 
         step = layer_step(z_step, radius_m, d.settings.delta_max)
     flank_step = _checks.whole("flank_step", flank_step, low=1, high=64)

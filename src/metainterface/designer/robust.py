@@ -12,11 +12,11 @@ from metainterface import _checks
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.perturb import Perturbation
-from metainterface.physical.printer import layer_step, length_in_r
-from metainterface.physical.units import (
+from metainterface.physics.cell import CellSettings
+from metainterface.units.printer import layer_step, length_in_r
+from metainterface.units.quantities import (
     parse_length,
 )
-from metainterface.physics.cell import CellSettings
 
 #: Made cells drawn to report a robust design's error distribution (independent of the
 #: K copies it was refined against).
@@ -62,7 +62,7 @@ def _robust_stats(
 ) -> DesignResult:
     """The result with ``robust``: its nominal error and the distribution of the error of
     made cells (independent draws), beside the rms error it was refined against."""
-    from metainterface.inverse.tolerance import spread
+    from metainterface.manufacture.errors import spread
 
     d = r.design
     check = Perturbation.draw(

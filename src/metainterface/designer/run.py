@@ -25,13 +25,13 @@ from metainterface.inverse.perturb import Perturbation
 from metainterface.inverse.reach import refuse_unreachable
 from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
-from metainterface.physical.dimensions import physical_block
-from metainterface.physical.units import (
-    parse_pressure,
-)
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.limits import PressureCheck, check_pressure, pressure_penalty
 from metainterface.physics.models import ForwardModel, get_model
+from metainterface.units.dimensions import physical_block
+from metainterface.units.quantities import (
+    parse_pressure,
+)
 from metainterface.verify.check import Verify, as_verify
 
 #: Upper bounds that keep a request within this machine's memory and a sane run time.

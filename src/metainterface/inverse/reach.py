@@ -10,10 +10,10 @@ import numpy as np
 from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError, UnreachableError
 from metainterface.inverse.targets import Target
-from metainterface.physical.friction import FrictionLaw, friction_target_in_units
-from metainterface.physical.reach import Reachability
-from metainterface.physical.reach import reachability as _reachability
 from metainterface.physics.cell import CellSettings
+from metainterface.units.friction import FrictionLaw, friction_target_in_units
+from metainterface.units.reach import Reachability
+from metainterface.units.reach import reachability as _reachability
 
 
 @uses_threads()

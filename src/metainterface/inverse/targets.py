@@ -149,7 +149,7 @@ class Target:
         "always" or "never" force it; the fit and its residual are in
         ``meta["friction"]["fit"]``.
         """
-        from metainterface.physical.friction import friction_target_in_units
+        from metainterface.units.friction import friction_target_in_units
 
         ft = friction_target_in_units(
             law,
@@ -164,7 +164,7 @@ class Target:
 
 
 def friction_law_target(ft: Any, source: str | os.PathLike[str], name: str | None = None) -> Target:
-    """The Target of a converted friction law (a ``physical.friction.FrictionTarget``) read
+    """The Target of a converted friction law (a ``units.friction.FrictionTarget``) read
     from the CSV ``source``: named after the file unless ``name``; the conversion in
     ``meta["friction"]``."""
     return Target(

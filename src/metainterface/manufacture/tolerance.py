@@ -24,14 +24,14 @@ from metainterface._threads import uses_threads
 from metainterface.designer.curves import ReachCounts, shown
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
-from metainterface.inverse import tolerance as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
 from metainterface.inverse.targets import Target
-from metainterface.physical.plausible import warn_unit_slips
-from metainterface.physical.printer import length_in_r
-from metainterface.physical.units import parse_pressure, parse_quantity
+from metainterface.manufacture import errors as tol
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, get_model
+from metainterface.units.plausible import warn_unit_slips
+from metainterface.units.printer import length_in_r
+from metainterface.units.quantities import parse_pressure, parse_quantity
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

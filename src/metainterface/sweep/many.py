@@ -41,8 +41,8 @@ from metainterface.validation.bem import (
     available_cpus,
 )
 from metainterface.validation.cluster import check_scheduler, dask_executor
-from metainterface.validation.engine import RETRIES, solve_task, stream
-from metainterface.validation.engines import check_engine, get_engine
+from metainterface.validation.executors import RETRIES, solve_task, stream
+from metainterface.validation.solvers import check_engine, get_engine
 from metainterface.validation.validate import (
     DEFAULT_LOADS,
     ValidationPlan,

@@ -49,8 +49,8 @@ from metainterface.validation.bem import (
     available_cpus,
 )
 from metainterface.validation.cluster import check_scheduler, dask_executor
-from metainterface.validation.engines import check_engine, get_engine
 from metainterface.validation.result import ValidationResult, design_target
+from metainterface.validation.solvers import check_engine, get_engine
 from metainterface.validation.validate import (
     DEFAULT_LOADS,
     check_jobs,

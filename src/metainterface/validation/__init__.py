@@ -14,14 +14,6 @@ from metainterface.validation.bem import (
     solve_loads,
     solve_path,
 )
-from metainterface.validation.engines import (
-    ENGINES,
-    TamaasEngine,
-    TorchEngine,
-    check_engine,
-    get_engine,
-    torch_threads,
-)
 from metainterface.validation.heightmap import (
     HeightMap,
     cell_height_map,
@@ -31,6 +23,14 @@ from metainterface.validation.heightmap import (
     owner_map,
 )
 from metainterface.validation.result import ValidationResult, design_target
+from metainterface.validation.solvers import (
+    ENGINES,
+    TamaasEngine,
+    TorchEngine,
+    check_engine,
+    get_engine,
+    torch_threads,
+)
 from metainterface.validation.validate import (
     DEFAULT_LOADS,
     ValidationPlan,

@@ -80,7 +80,7 @@ def solve_path(
     load (``LoadPath.pressures``, ``gaps``; 2 K M^2 floats). Raises MetainterfaceError
     naming the load and the residual if a solve does not converge.
     """
-    from metainterface.validation.engines import get_engine
+    from metainterface.validation.solvers import get_engine
 
     return get_engine(engine).solve_path(
         heights,

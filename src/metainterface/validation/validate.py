@@ -34,13 +34,13 @@ from metainterface.validation.bem import (
     solve_loads,
     split_path,
 )
-from metainterface.validation.engine import BemTask, solve_task, stream
-from metainterface.validation.engines import check_engine
+from metainterface.validation.executors import BemTask, solve_task, stream
 from metainterface.validation.heightmap import HeightMap, check_grid, default_grid, height_map
 from metainterface.validation.result import (
     ValidationResult,
     design_target,
 )
+from metainterface.validation.solvers import check_engine
 
 #: Default number of loads of a path.
 DEFAULT_LOADS = 20

@@ -132,7 +132,7 @@ class Verify:
     def ready(self, cell: CellSettings) -> None:
         """Check what only the run can tell, before any work: the grid against the cell, the
         engine installed (Tamaas) and the device seen by torch. One-line errors."""
-        from metainterface.validation.engines import check_engine
+        from metainterface.validation.solvers import check_engine
 
         self.grid_for(cell)
         check_engine(self.engine, self.device)

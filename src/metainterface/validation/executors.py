@@ -28,8 +28,8 @@ from metainterface._process import die_with_parent
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.validation.bem import LoadPath, solve_path
-from metainterface.validation.engines import torch_threads
 from metainterface.validation.heightmap import height_map
+from metainterface.validation.solvers import torch_threads
 
 #: Times a task the engine lost (a dead worker, a broken pool) is submitted again.
 RETRIES = 2

@@ -28,8 +28,8 @@ import numpy as np
 from metainterface._files.columns import Table, read_table
 from metainterface._names import FIT_NAMES
 from metainterface.errors import MetainterfaceError
-from metainterface.physical._lawfit import LawFit, fit_law
 from metainterface.physics.cell import CellSettings
+from metainterface.units._lawfit import LawFit, fit_law
 
 #: Points a target needs (the design command's minimum), the added origin included.
 MIN_POINTS = 3
@@ -64,7 +64,7 @@ FRICTION_NAMES = ("normal_force", "friction_force", "friction_coefficient")
 
 def _forces(table: Table, name: str) -> np.ndarray:
     """A force column in newtons, converted from the unit its header gives (none: N)."""
-    from metainterface.physical.units import force_unit
+    from metainterface.units.quantities import force_unit
 
     unit = table.unit(name)
     where = f"{table.path}: column {name}" + ("" if unit is None else f" [{unit}]")
@@ -309,7 +309,7 @@ def friction_target(
     """Convert a friction law (a FrictionLaw or a CSV path) into the alpha(P*) target.
 
     shear_strength tau [Pa], e_star E* [Pa], radius R [m], area: nominal area of the whole
-    interface [m^2], all > 0 (parse them with ``metainterface.physical.units``). settings: the cell
+    interface [m^2], all > 0 (parse them with ``units.quantities``). settings: the cell
     (default: the paper's), used for L. include_origin: prepend (0 N, 0 N) when the first load
     is > 0 (F_f = tau A_real vanishes with the load). fit: "auto", "always" or "never",
     when the rows are replaced by a monotone smooth fit (:func:`prepare_law`; the fit is
@@ -426,8 +426,8 @@ def friction_target_in_units(
     numbers in SI. A bad quantity's error names its argument (``shear_strength``), or with
     ``options`` the command-line option (``--shear-strength``); a likely unit slip
     (:mod:`.plausible`) warns."""
-    from metainterface.physical.plausible import warn_unit_slips
-    from metainterface.physical.units import parse_area, parse_length, parse_pressure
+    from metainterface.units.plausible import warn_unit_slips
+    from metainterface.units.quantities import parse_area, parse_length, parse_pressure
 
     def name(arg: str) -> str:
         return "--" + arg.replace("_", "-") if options else arg

@@ -3,7 +3,7 @@
 import pytest
 
 from metainterface.errors import MetainterfaceError
-from metainterface.physical.units import (
+from metainterface.units.quantities import (
     parse_area,
     parse_force,
     parse_length,

@@ -211,8 +211,8 @@ SLIPS = [
 
 @pytest.mark.parametrize(("scale", "message"), SLIPS)
 def test_a_unit_slip_warns_once_at_the_users_line(law_file, scale, message):
-    from metainterface.physical.plausible import unit_slips
-    from metainterface.physical.units import parse_length, parse_pressure
+    from metainterface.units.plausible import unit_slips
+    from metainterface.units.quantities import parse_length, parse_pressure
 
     si = {
         "modulus": parse_pressure(scale.get("modulus", "2MPa")),
@@ -231,7 +231,7 @@ def test_a_unit_slip_warns_once_at_the_users_line(law_file, scale, message):
 
 
 def test_plausible_scales_do_not_warn(law_file):
-    from metainterface.physical.plausible import unit_slips
+    from metainterface.units.plausible import unit_slips
 
     assert unit_slips(modulus=2e6, shear_strength=0.25e6, radius=5e-4) == []
     assert unit_slips(modulus=1e3, shear_strength=1e3, radius=0.1) == []  # the edges

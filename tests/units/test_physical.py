@@ -7,9 +7,9 @@ import pytest
 
 import metainterface
 from metainterface.errors import MetainterfaceError
-from metainterface.physical.dimensions import physical_block
 from metainterface.physics import Design
 from metainterface.physics.curves import design_sweep
+from metainterface.units.dimensions import physical_block
 
 EXAMPLE = Path(metainterface.__file__).parent / "examples" / "example_design.json"
 R, E = 0.5e-3, 2e6

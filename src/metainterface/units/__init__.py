@@ -1,12 +1,12 @@
 """Physical units at the edges of the scale-free core.
 
-Quantities parsed with pint (``units``), a friction law in newtons turned into an alpha(P*)
+Quantities parsed with pint (``quantities``), a friction law in newtons turned into an alpha(P*)
 target and back (``friction``, Bowden-Tabor), and the dimensions of a design in SI for a
 given asperity radius and modulus (``dimensions``).
 """
 
-from metainterface.physical.dimensions import physical_block
-from metainterface.physical.friction import (
+from metainterface.units.dimensions import physical_block
+from metainterface.units.friction import (
     FrictionLaw,
     FrictionTarget,
     alpha_to_friction,
@@ -15,7 +15,7 @@ from metainterface.physical.friction import (
     friction_to_alpha,
     read_friction_csv,
 )
-from metainterface.physical.units import (
+from metainterface.units.quantities import (
     parse_area,
     parse_force,
     parse_length,

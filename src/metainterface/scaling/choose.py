@@ -15,10 +15,10 @@ import numpy as np
 from metainterface._threads import uses_threads
 from metainterface.designer.options import Effort
 from metainterface.errors import MetainterfaceError, UnitSlipWarning
-from metainterface.inverse import scale as _scale
 from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
+from metainterface.scaling import search as _scale
 
 #: Candidate scales designed quickly before the chosen one is designed in full.
 CANDIDATES = 5
@@ -29,7 +29,7 @@ _OPTIONS = {"area": "area", "modulus": "modulus", "shear_strength": "shear_stren
 
 
 def _parser(var: str):
-    from metainterface.physical.units import parse_area, parse_pressure
+    from metainterface.units.quantities import parse_area, parse_pressure
 
     return parse_area if var == "area" else parse_pressure
 
@@ -68,9 +68,9 @@ def _law_and_scale(
     fit: str,
 ) -> tuple[Any, Any, dict[str, float], str | None, tuple[float, float] | None]:
     """(law, fit, given SI scale, the variable left free or None, its bounds)."""
-    from metainterface.physical.friction import prepare_law
-    from metainterface.physical.plausible import warn_unit_slips
-    from metainterface.physical.units import parse_length
+    from metainterface.units.friction import prepare_law
+    from metainterface.units.plausible import warn_unit_slips
+    from metainterface.units.quantities import parse_length
 
     values = {"area": area, "modulus": modulus, "shear_strength": shear_strength}
     given: dict[str, float] = {}
@@ -246,7 +246,7 @@ def design_scale(
     feasibility summary, and design.json records them.
     """
     from metainterface.designer.run import design
-    from metainterface.physical.friction import FrictionLaw, friction_target
+    from metainterface.units.friction import FrictionLaw, friction_target
 
     source = str(law) if not isinstance(law, FrictionLaw) else law.source
     law, lf, given, var, span = _law_and_scale(law, shear_strength, modulus, radius, area, fit)
@@ -275,7 +275,7 @@ def design_scale(
         )
         record = ft.record()
         if lf is not None:
-            from metainterface.physical.friction import fit_record
+            from metainterface.units.friction import fit_record
 
             record["fit"] = fit_record(lf)
         return Target(

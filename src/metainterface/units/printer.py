@@ -7,7 +7,7 @@ from typing import Any
 
 from metainterface import _checks
 from metainterface.errors import MetainterfaceError
-from metainterface.physical.units import parse_quantity
+from metainterface.units.quantities import parse_quantity
 
 
 def length_in_r(value: Any, radius_m: float | None, *, option: str, radius_option: str) -> float:

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from metainterface.errors import MetainterfaceError
-from metainterface.physical._lawfit import fit_law
-from metainterface.physical.friction import FrictionLaw, friction_target, prepare_law
+from metainterface.units._lawfit import fit_law
+from metainterface.units.friction import FrictionLaw, friction_target, prepare_law
 
 TAU, E_STAR, RADIUS, AREA = 0.25e6, 2e6, 0.5e-3, 4e-4
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import metainterface as mi
-from metainterface.physical.friction import alpha_to_friction
 from metainterface.physics.curves import design_sweep
+from metainterface.units.friction import alpha_to_friction
 
 TAU, E_STAR = 0.25e6, 2e6
 TRUE_AREA = 8e-4  # the law is a cell's own curve at 8 cm^2

@@ -7,7 +7,9 @@ import pytest
 
 import metainterface
 from metainterface.errors import MetainterfaceError
-from metainterface.physical.friction import (
+from metainterface.physics import Design
+from metainterface.physics.curves import design_sweep
+from metainterface.units.friction import (
     alpha_to_friction,
     friction_columns,
     friction_target,
@@ -15,8 +17,6 @@ from metainterface.physical.friction import (
     friction_to_alpha,
     read_friction_csv,
 )
-from metainterface.physics import Design
-from metainterface.physics.curves import design_sweep
 
 TAU, E_STAR, RADIUS, AREA = 0.25e6, 2e6, 0.5e-3, 4e-4  # 0.25 MPa, 2 MPa, 0.5 mm, 4 cm^2
 EXAMPLE = Path(metainterface.__file__).parent / "examples" / "example_design.json"

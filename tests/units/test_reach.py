@@ -10,8 +10,8 @@ import torch
 
 import metainterface as mi
 from metainterface.cli import main
-from metainterface.physical.reach import alpha_bounds, reachability
 from metainterface.physics.curves import sweep
+from metainterface.units.reach import alpha_bounds, reachability
 
 UNITS = dict(shear_strength="0.25MPa", modulus="2MPa", area="4cm2", radius="0.5mm")
 FN = np.linspace(0.25, 6.0, 24)
