@@ -115,7 +115,11 @@ def idle_count(r) -> int:
 
 def zero_shot_designs(targets: list[mi.Target], surrogate: str | None = None) -> list:
     """Zero-shot designs; ``surrogate`` a model file (None: `design`'s default networks)."""
-    return mi.design(targets, refine=False, hedge=0, fallback=0, verify=False, surrogate=surrogate)
+    return mi.design(
+        targets,
+        verify=False,
+        effort=mi.Effort(refine=False, hedge=0, fallback=0, surrogate=surrogate),
+    )
 
 
 def zero_shot(targets: list[mi.Target], surrogate: str | None = None) -> np.ndarray:

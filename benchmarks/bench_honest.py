@@ -47,7 +47,9 @@ def main() -> None:
             r = mi.reachability(law, **UNITS)
             t0 = time.perf_counter()
             res = mi.design(
-                mi.Target.from_friction(law, **UNITS), force=True, refine=not args.quick
+                mi.Target.from_friction(law, **UNITS),
+                force=True,
+                effort=mi.Effort(refine=not args.quick),
             )
             sec = time.perf_counter() - t0
             design = design or res.design

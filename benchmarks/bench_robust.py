@@ -67,7 +67,7 @@ def main() -> None:
     nominal = mi.design(targets)
     t_nom = time.perf_counter() - t0
     t0 = time.perf_counter()
-    robust = mi.design(targets, robust=True, robust_samples=args.copies, **kw)
+    robust = mi.design(targets, robust=mi.Robust(samples=args.copies), **kw)
     t_rob = time.perf_counter() - t0
     pert = Perturbation.draw(
         9, args.samples, 12345, sigma_h=args.sigma_h, sigma_gamma=args.sigma_gamma

@@ -93,7 +93,12 @@ def test_a_registered_model_works_in_design_and_curve(monkeypatch):
     )
     t = mi.Target(p_star=[0, 1e-4, 2e-4, 3e-4], alpha=[0, 0.004, 0.007, 0.009], name="x")
     r = mi.design(
-        t, method="multistart", starts=2, model="stiff", settings=d.settings, verify=False
+        t,
+        method="multistart",
+        model="stiff",
+        settings=d.settings,
+        verify=False,
+        effort=mi.Effort(starts=2),
     )
     assert r.model.name == "stiff" and np.isfinite(r.error)
 
@@ -108,11 +113,16 @@ def test_design_save_load_round_trip(tmp_path):
 
 
 def test_design_of_one_target_and_of_a_list(tmp_path):
-    r = mi.design("saturating", method="multistart", starts=3, seed=1, verify=False)
+    r = mi.design(
+        "saturating", method="multistart", verify=False, effort=mi.Effort(starts=3, seed=1)
+    )
     assert isinstance(r, mi.DesignResult) and isinstance(r.design, mi.Design)
     assert r.error < 0.05 and "saturating" in repr(r)
     both = mi.design(
-        [mi.Target.builtin("bilinear"), "linear"], method="hertz", starts=2, verify=False
+        [mi.Target.builtin("bilinear"), "linear"],
+        method="hertz",
+        verify=False,
+        effort=mi.Effort(starts=2),
     )
     assert [x.target.name for x in both] == ["bilinear", "linear"]
     assert all(np.all(x.design.gamma == 2.0) for x in both)  # the Hertz parameterisation
@@ -129,7 +139,7 @@ def test_another_design_space_falls_back_to_multistart():
     c = mi.curve(src, steps=64)
     t = mi.Target(p_star=c.p_star, alpha=c.alpha, name="four")
     with pytest.warns(UserWarning, match="trained for another cell"):
-        r = mi.design(t, settings=s, starts=4, seed=0, verify=False)
+        r = mi.design(t, settings=s, verify=False, effort=mi.Effort(starts=4, seed=0))
     assert r.method == "multistart" and r.design.n_asperities == 4
     assert r.notes and "multistart" in r.notes[0]
     assert r.error < 0.05

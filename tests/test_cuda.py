@@ -58,7 +58,11 @@ def test_training_on_cuda_loads_and_resumes_on_cpu(tmp_path):
     assert all(v.device.type == "cpu" for v in ckpt["model"].values())
     model, _, _ = load_model(run.run_dir / "model.pt")  # on the CPU
     assert next(model.parameters()).device.type == "cpu"
-    d = mi.design("saturating", surrogate=run.run_dir / "model.pt", refine=False, device="cpu")
+    d = mi.design(
+        "saturating",
+        device="cpu",
+        effort=mi.Effort(surrogate=run.run_dir / "model.pt", refine=False),
+    )
     assert np.isfinite(d.error)
     # its checkpoint (optimiser state made on the GPU) resumes on the CPU
     again = mi.train_surrogate(
@@ -122,12 +126,17 @@ def test_design_on_cuda_matches_cpu(method):
 def test_many_targets_on_cuda():
     builtins = [mi.Target.builtin(n) for n in ("saturating", "bilinear", "linear")] * 34
     targets = [replace(t, name=f"{t.name}-{i}") for i, t in enumerate(builtins)]
-    results = mi.design(targets, refine_settings=QUICK, device="cuda")
+    results = mi.design(targets, device="cuda", effort=mi.Effort(refine_settings=QUICK))
     assert len(results) == 102 and all(np.isfinite(r.error) for r in results)
 
 
 def test_tolerance_and_curve_on_cuda_match_cpu():
-    d = mi.design("saturating", method="multistart", starts=2, refine_settings=QUICK, device="cpu")
+    d = mi.design(
+        "saturating",
+        method="multistart",
+        device="cpu",
+        effort=mi.Effort(starts=2, refine_settings=QUICK),
+    )
     a = mi.tolerance(d, sigma_h=0.001, samples=512, device="cpu")
     b = mi.tolerance(d, sigma_h=0.001, samples=512, device="cuda")
     np.testing.assert_allclose(b.errors, a.errors, rtol=1e-6, atol=1e-9)
@@ -137,13 +146,10 @@ def test_tolerance_and_curve_on_cuda_match_cpu():
     r = mi.design(
         "saturating",
         method="multistart",
-        starts=2,
-        refine_settings=QUICK,
-        robust=True,
-        sigma_h=0.001,
-        robust_samples=4,
+        robust=mi.Robust(sigma_h=0.001, samples=4),
         z_step=0.001,
         device="cuda",
+        effort=mi.Effort(starts=2, refine_settings=QUICK),
     )
     assert r.robust is not None and r.printable is not None
     s = mi.min_radius(d, printer_sigma="1um", max_error=0.05, samples=64, device="cuda")

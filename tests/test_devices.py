@@ -159,7 +159,9 @@ def test_robust_printable_design_on_cpu_and_auto():
 
 
 def test_tolerance_min_radius_curve_on_cpu_and_auto():
-    d = mi.design("saturating", method="multistart", starts=2, refine_settings=QUICK)
+    d = mi.design(
+        "saturating", method="multistart", effort=mi.Effort(starts=2, refine_settings=QUICK)
+    )
     tols = [mi.tolerance(d, sigma_h=0.001, samples=64, device=x) for x in DEVICES]
     for t in tols[1:]:
         np.testing.assert_array_equal(t.errors, tols[0].errors)
@@ -200,7 +202,7 @@ def test_the_memory_check_counts_a_robust_designs_copies(monkeypatch):
     many = [mi.Target(p_star=t.p_star, alpha=t.alpha, name=f"t{i}") for i in range(300)]
     robust = mi.Robust(sigma_h=0.001, samples=64)
     with pytest.raises(MetainterfaceError, match=r"with 64 robust samples each") as e:
-        mi.design(many, robust=robust, hedge=8, fallback=0, verify=False)
+        mi.design(many, robust=robust, verify=False, effort=mi.Effort(hedge=8, fallback=0))
     assert "\n" not in str(e.value)
 
 

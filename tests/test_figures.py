@@ -114,7 +114,9 @@ def friction_result(tmp_path_factory):
         law, shear_strength="0.25MPa", modulus="2MPa", radius="0.5mm", area="4cm2"
     )
     # no cell reaches this law at these E*, tau and area: the figure of a forced design
-    return mi.design(t, refine=False, hedge=0, fallback=0, force=True, verify=False)
+    return mi.design(
+        t, force=True, verify=False, effort=mi.Effort(refine=False, hedge=0, fallback=0)
+    )
 
 
 @pytest.fixture(scope="module")
@@ -122,7 +124,7 @@ def csv_result(tmp_path_factory):
     """A CSV target much longer than the design's pressure range needs."""
     p = np.linspace(0.0, 0.002, 5000)
     t = mi.Target(p_star=p, alpha=0.04 * (1 - np.exp(-p / 0.0006)), name="measured")
-    return mi.design(t, refine=False, hedge=0, fallback=0, verify=False)
+    return mi.design(t, verify=False, effort=mi.Effort(refine=False, hedge=0, fallback=0))
 
 
 @pytest.mark.parametrize("width", [SMALL, LARGE])
@@ -165,7 +167,7 @@ def test_pressure_tick_labels_do_not_run_together(width):
     scaled into the axis label instead."""
     p = np.linspace(0.0, 0.0125, 200)
     t = mi.Target(p_star=p, alpha=0.9 * (1 - np.exp(-p / 0.004)), name="wide")
-    r = mi.design(t, refine=False, hedge=0, fallback=0)
+    r = mi.design(t, effort=mi.Effort(refine=False, hedge=0, fallback=0))
     fig = r.figure(width=width)
     assert _tick_overlaps(fig) == []
     area = next(ax for ax in fig.axes if ax.get_title() == "contact area")
@@ -193,7 +195,7 @@ def stopping_result(tmp_path_factory):
     t = mi.Target.from_friction(
         law, shear_strength="0.25MPa", modulus="2MPa", radius="0.5mm", area="4cm2"
     )
-    return mi.design(t, hedge=0, fallback=0, force=True, verify=False)
+    return mi.design(t, force=True, verify=False, effort=mi.Effort(hedge=0, fallback=0))
 
 
 def test_design_figure_shows_where_a_design_stops(stopping_result):

@@ -28,7 +28,8 @@ def test_groups_are_frozen_values_with_design_defaults() -> None:
 def test_effort_designs_as_its_keywords() -> None:
     effort = mi.Effort(starts=4, refine=False, seed=3)
     grouped = mi.design("bilinear", effort=effort, **QUICK)
-    flat = mi.design("bilinear", starts=4, refine=False, seed=3, **QUICK)
+    with pytest.deprecated_call(match=r"pass effort=mi.Effort\(starts=\.\.\., refine="):
+        flat = mi.design("bilinear", starts=4, refine=False, seed=3, **QUICK)
     np.testing.assert_array_equal(grouped.design.gamma, flat.design.gamma)
     np.testing.assert_array_equal(grouped.design.h, flat.design.h)
     again = mi.design("saturating", effort=effort, **QUICK)  # reused for another target
@@ -40,9 +41,10 @@ def test_robust_is_robust_true_with_its_errors() -> None:
     grouped = mi.design(
         "bilinear", effort=quick, robust=mi.Robust(sigma_h=0.002, samples=2), **QUICK
     )
-    flat = mi.design(
-        "bilinear", effort=quick, robust=True, sigma_h=0.002, robust_samples=2, **QUICK
-    )
+    with pytest.deprecated_call(match=r"robust=mi.Robust\(sigma_h=\.\.\., samples="):
+        flat = mi.design(
+            "bilinear", effort=quick, robust=True, sigma_h=0.002, robust_samples=2, **QUICK
+        )
     assert grouped.robust == flat.robust
     assert grouped.robust["robust_samples"] == 2
 
@@ -51,7 +53,8 @@ def test_scale_reads_a_stress_limit_and_writes_the_si_block(tmp_path) -> None:
     quick = mi.Effort(starts=2, refine=False)
     pad = mi.Scale(radius="0.5mm", modulus="2MPa", area="4cm2")
     r = mi.design("bilinear", effort=quick, scale=pad, max_pressure="1MPa", out=tmp_path, **QUICK)
-    flat = mi.design("bilinear", effort=quick, modulus="2MPa", max_pressure="1MPa", **QUICK)
+    with pytest.deprecated_call(match="scale=mi.Scale"):
+        flat = mi.design("bilinear", effort=quick, modulus="2MPa", max_pressure="1MPa", **QUICK)
     assert r.pressure is not None and r.pressure.e_star == flat.pressure.e_star == 2e6
     np.testing.assert_array_equal(r.pressure.peak, flat.pressure.peak)
     block = json.loads((tmp_path / "design.json").read_text())["physical"]
@@ -78,3 +81,25 @@ def test_help_of_design_fits_one_screen() -> None:
     assert len(mi.design.__doc__.splitlines()) <= 60
     for group in (mi.Effort, mi.Scale, mi.Robust):
         assert "Examples" in group.__doc__
+
+
+def test_design_takes_at_most_15_parameters_and_fits_a_screen() -> None:
+    import contextlib
+    import inspect
+    import io
+
+    assert len(inspect.signature(mi.design).parameters) <= 15
+    text = io.StringIO()
+    with contextlib.redirect_stdout(text):
+        help(mi.design)
+    assert len(text.getvalue().splitlines()) <= 40
+
+
+def test_an_unknown_keyword_is_one_line() -> None:
+    with pytest.raises(mi.MetainterfaceError, match="unexpected keyword 'stars'"):
+        mi.design("bilinear", stars=3)
+
+
+def test_an_old_error_without_robust_is_still_one_line() -> None:
+    with pytest.deprecated_call(), pytest.raises(mi.MetainterfaceError, match="need robust=True"):
+        mi.design("bilinear", sigma_h=0.001)

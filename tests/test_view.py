@@ -65,7 +65,7 @@ def test_page_is_one_self_contained_file(design_folder):
 def test_view_of_objects_and_folders(tmp_path, design_folder):
     d = mi.Design.load(design_folder / "design.json")
     assert mi.view(d, tmp_path / "d.html").stat().st_size > 1_000_000
-    r = mi.design("linear", refine=False, hedge=0, fallback=0, verify=False)
+    r = mi.design("linear", verify=False, effort=mi.Effort(refine=False, hedge=0, fallback=0))
     path = mi.view(r, tmp_path / "r.html")
     assert "linear" in path.read_text(encoding="utf-8")[:5000]
     assert main(["view", str(design_folder), "--out", str(tmp_path / "c.html")]) == 0

@@ -57,7 +57,9 @@ def stopped(tmp_path_factory):
         name="longer",
     )
     folder = tmp_path_factory.mktemp("stopped")
-    return mi.design(longer, hedge=0, fallback=0, out=folder, verify=False), folder
+    return mi.design(
+        longer, out=folder, verify=False, effort=mi.Effort(hedge=0, fallback=0)
+    ), folder
 
 
 def test_design_reports_coverage_and_carrying(stopped):

@@ -13,7 +13,12 @@ DMAX = 0.02
 
 def test_z_step_puts_heights_on_the_grid_and_reports_the_cost(tmp_path):
     r = mi.design(
-        "bilinear", z_step="1um", radius="0.5mm", out=tmp_path, verify=False, hedge=2, fallback=0
+        "bilinear",
+        z_step="1um",
+        out=tmp_path,
+        verify=False,
+        scale=mi.Scale(radius="0.5mm"),
+        effort=mi.Effort(hedge=2, fallback=0),
     )
     step = 1e-6 / 0.5e-3
     levels = r.design.h / step
@@ -37,15 +42,16 @@ def test_z_step_puts_heights_on_the_grid_and_reports_the_cost(tmp_path):
         ({"z_step": 0.05}, "z_step must be in (0, Delta_max"),
         ({"z_step": -0.001}, "z_step"),
         ({"z_step": "1um"}, "give radius"),
-        ({"z_step": "1MPa", "radius": "1mm"}, "z_step expects a length"),
+        ({"z_step": "1MPa", "scale": mi.Scale(radius="1mm")}, "z_step expects a length"),
         ({"robust": True}, "needs sigma_h"),
-        ({"sigma_h": 0.001}, "need robust=True"),
-        ({"robust": True, "sigma_h": -1.0}, "sigma_h"),
-        ({"robust": True, "sigma_gamma": float("nan")}, "sigma_gamma"),
-        ({"robust": True, "sigma_h": 0.001, "robust_samples": 0}, "robust_samples"),
+        ({"robust": mi.Robust()}, "needs sigma_h"),
+        ({"robust": mi.Robust(sigma_h=-1.0)}, "sigma_h"),
+        ({"robust": mi.Robust(sigma_gamma=float("nan"))}, "sigma_gamma"),
+        ({"robust": mi.Robust(sigma_h=0.001, samples=0)}, "robust_samples"),
     ],
 )
 def test_bad_manufacturing_options_are_one_line(kwargs, fragment):
+    """(The old one-by-one keywords' errors: tests/test_options.py.)"""
     with pytest.raises(mi.MetainterfaceError) as exc:
         mi.design("bilinear", **kwargs)
     assert fragment in str(exc.value) and "\n" not in str(exc.value)
@@ -72,12 +78,10 @@ def test_robust_design_reports_both_and_lowers_the_made_error(tmp_path):
     quick = mi.Effort(hedge=2, fallback=0)
     rob = mi.design(
         "saturating",
-        robust=True,
-        robust_samples=8,
+        robust=mi.Robust(samples=8, **kw),
         out=tmp_path / "r",
         verify=False,
         effort=quick,
-        **kw,
     )
     nom = mi.design("saturating", out=tmp_path / "n", verify=False, effort=quick)
     s = rob.robust

@@ -90,12 +90,9 @@ def test_errors_are_to_the_design_files_target_and_match_design(tmp_path):
     res = mi.design(
         t,
         method="multistart",
-        starts=4,
-        hedge=0,
-        fallback=0,
-        refine_settings=None,
         out=tmp_path / "d",
         verify=False,
+        effort=mi.Effort(starts=4, hedge=0, fallback=0, refine_settings=None),
     )
     r = mi.tolerance(tmp_path / "d" / "design.json", sigma_h=0.0, samples=16)
     assert r.reference is not None and r.reference.name == "saturating"
@@ -104,7 +101,7 @@ def test_errors_are_to_the_design_files_target_and_match_design(tmp_path):
 
 
 def test_a_design_result_is_measured_to_its_own_target():
-    res = mi.design("saturating", method="multistart", starts=4, verify=False)
+    res = mi.design("saturating", method="multistart", verify=False, effort=mi.Effort(starts=4))
     r = mi.tolerance(res, sigma_h=0.0, samples=16)
     assert r.reference is not None and r.reference.name == "saturating"
     assert r.error_nominal == pytest.approx(res.error, rel=1e-3, abs=1e-7)

@@ -184,14 +184,14 @@ def api_cases(tmp):
     """(callable, the argument its error must name)."""
     t = "linear"
     return [
-        (lambda: mi.design(t, starts=0), "starts"),
-        (lambda: mi.design(t, starts=2**70), "starts"),
-        (lambda: mi.design(t, starts=2.5), "starts"),
-        (lambda: mi.design(t, starts=True), "starts"),
-        (lambda: mi.design(t, hedge=-1), "hedge"),
-        (lambda: mi.design(t, fallback=-1), "fallback"),
-        (lambda: mi.design(t, seed=-1), "seed"),
-        (lambda: mi.design(t, seed=2**70), "seed"),
+        (lambda: mi.design(t, effort=mi.Effort(starts=0)), "starts"),
+        (lambda: mi.design(t, effort=mi.Effort(starts=2**70)), "starts"),
+        (lambda: mi.design(t, effort=mi.Effort(starts=2.5)), "starts"),
+        (lambda: mi.design(t, effort=mi.Effort(starts=True)), "starts"),
+        (lambda: mi.design(t, effort=mi.Effort(hedge=-1)), "hedge"),
+        (lambda: mi.design(t, effort=mi.Effort(fallback=-1)), "fallback"),
+        (lambda: mi.design(t, effort=mi.Effort(seed=-1)), "seed"),
+        (lambda: mi.design(t, effort=mi.Effort(seed=2**70)), "seed"),
         (lambda: mi.design(t, method="magic"), "method"),
         (lambda: mi.design(t, model="magic"), "magic"),
         (lambda: mi.design(t, max_pressure=-1), "max_pressure"),

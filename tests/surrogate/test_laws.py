@@ -138,7 +138,9 @@ def test_design_reads_friction_laws_with_the_law_network(tmp_path):
     alone = tmp_path / "surrogate.pt"  # the shipped surrogate under another name: no laws net
     shutil.copy(default_model_path(), alone)
     quick = dict(refine=False, hedge=0, fallback=0, verify=False)
-    before = np.array([r.error for r in mi.design(targets, surrogate=alone, **quick)])
+    before = np.array(
+        [r.error for r in mi.design(targets, **quick, effort=mi.Effort(surrogate=alone))]
+    )
     made = mi.design(targets, **quick)
     after = np.array([r.error for r in made])
     assert any(r.zero_shot_from.startswith("friction-law network") for r in made)
@@ -149,11 +151,14 @@ def test_design_reads_friction_laws_with_the_law_network(tmp_path):
     with_s = mi.Target(
         p_star=targets[0].p_star, alpha=targets[0].alpha, stiffness=np.ones_like(targets[0].p_star)
     )
-    a = mi.design(with_s, surrogate=alone, **quick)
+    a = mi.design(with_s, **quick, effort=mi.Effort(surrogate=alone))
     b = mi.design(with_s, **quick)
     np.testing.assert_array_equal(a.design.gamma, b.design.gamma)
     assert b.zero_shot_from == "surrogate"
-    assert mi.design(with_s, method="multistart", starts=2, **quick).zero_shot_from == ""
+    assert (
+        mi.design(with_s, method="multistart", **quick, effort=mi.Effort(starts=2)).zero_shot_from
+        == ""
+    )
 
 
 def test_a_refined_design_is_never_worse_than_its_start():
@@ -165,7 +170,7 @@ def test_a_refined_design_is_never_worse_than_its_start():
         law, shear_strength=TAU, e_star=E_STAR, radius=RADIUS, area=17.6e-4, fit="never"
     )
     target = mi.Target(p_star=t.p_star, alpha=t.alpha, name="sat")
-    r = mi.design(target, hedge=0, fallback=0, verify=False, force=True)
+    r = mi.design(target, verify=False, force=True, effort=mi.Effort(hedge=0, fallback=0))
     # (re-seeding idle asperities may trade a little error for a cell that uses them)
     assert r.error <= max(r.initial_error * (1 + RESEED_SLACK), r.initial_error + RESEED_FLOOR)
 

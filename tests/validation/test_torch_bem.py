@@ -96,7 +96,9 @@ def _random_design(seed):
 
 
 def _designs():
-    targets = mi.design(["saturating", "bilinear", "linear"], method="hertz", starts=2, seed=0)
+    targets = mi.design(
+        ["saturating", "bilinear", "linear"], method="hertz", effort=mi.Effort(starts=2, seed=0)
+    )
     return {
         **{f"target-{r.target.name}": r.design for r in targets},
         "example": EXAMPLE,

@@ -184,7 +184,12 @@ def test_bad_verify_arguments_fail_before_the_design():
     with pytest.raises(mi.MetainterfaceError, match="verify must be True, False or a Verify"):
         mi.design("bilinear", verify="yes")
     with pytest.raises(mi.MetainterfaceError, match="grid must be a multiple of the lattice"):
-        mi.design("bilinear", verify=Verify(grid=97), method="hertz", starts=1, refine=False)
+        mi.design(
+            "bilinear",
+            verify=Verify(grid=97),
+            method="hertz",
+            effort=mi.Effort(starts=1, refine=False),
+        )
 
 
 def test_design_json_and_figure_carry_the_check(checked, tmp_path):
@@ -241,7 +246,9 @@ def test_the_engine_and_device_reach_the_solver_and_fail_early(unchecked):
     )
     np.testing.assert_allclose(ours.alpha_bem, tam.alpha_bem, rtol=1e-6)
     with pytest.raises(mi.MetainterfaceError, match="device"):
-        mi.design("bilinear", verify=Verify(device="tpu"), method="hertz", refine=False)
+        mi.design(
+            "bilinear", verify=Verify(device="tpu"), method="hertz", effort=mi.Effort(refine=False)
+        )
 
 
 def test_cli_engine_option_names_itself(tmp_path, capsys):

@@ -13,6 +13,9 @@ from __future__ import annotations
 import hashlib
 import json
 import platform
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from datetime import UTC, datetime
 from typing import Any
 
@@ -22,6 +25,26 @@ from metainterface._files import strict_json
 MAX_INLINE = 200
 #: Hex digits of the short hashes (64 bits: collisions are no concern for a record).
 HASH_DIGITS = 16
+
+
+#: The command line being run (its options as given), set by the CLI around its one library
+#: call, so that the files written record it without a parameter threaded through the API.
+_COMMAND: ContextVar[dict[str, Any] | None] = ContextVar("metainterface_command", default=None)
+
+
+@contextmanager
+def recording_command(options: dict[str, Any]) -> Iterator[None]:
+    """Within this block, design files record ``options`` as the command that made them."""
+    token = _COMMAND.set(options)
+    try:
+        yield
+    finally:
+        _COMMAND.reset(token)
+
+
+def current_command() -> dict[str, Any] | None:
+    """The command being run (see :func:`recording_command`), or None from Python."""
+    return _COMMAND.get()
 
 
 def short_hash(value: Any) -> str:

@@ -28,7 +28,7 @@ def verify(args: argparse.Namespace):
     )
 
 
-def manufacturing(args: argparse.Namespace) -> dict:
+def _manufacturing(args: argparse.Namespace) -> dict:
     """The robust-design and layer options, lengths in units of R (errors name the options)."""
     import metainterface as mi
     from metainterface.units import parse_length
@@ -53,14 +53,38 @@ def manufacturing(args: argparse.Namespace) -> dict:
     # errors carry the argument and so are shown under these option names
     if sigma_h == args.sigma_gamma == args.scale_sigma == 0.0:
         raise mi.MetainterfaceError("--robust needs --sigma-h, --sigma-gamma or --scale-sigma > 0")
-    out.update(
-        robust=True,
+    out["robust"] = mi.Robust(
         sigma_h=sigma_h,
         sigma_gamma=args.sigma_gamma,
         scale_sigma=args.scale_sigma,
-        robust_samples=args.robust_samples,
+        samples=args.robust_samples,
     )
     return out
+
+
+def groups(args: argparse.Namespace) -> dict:
+    """The command line's flat options mapped to ``mi.design``'s groups: the one place where
+    they meet (``effort``, ``scale``, ``robust`` and ``z_step``)."""
+    import metainterface as mi
+
+    def given(**values):
+        return {k: v for k, v in values.items() if v is not None}
+
+    effort = given(
+        refine=args.refine == "lbfgs",
+        surrogate=args.model,
+        starts=args.starts,
+        seed=args.seed,
+        hedge=args.hedge,
+        fallback=args.fallback,
+    )
+    scale = given(
+        modulus=args.modulus,
+        radius=args.radius,
+        total_force=args.total_force,
+        area=args.area if args.total_force is None else None,
+    )
+    return {"effort": mi.Effort(**effort), "scale": mi.Scale(**scale), **_manufacturing(args)}
 
 
 def settings(args: argparse.Namespace):

@@ -12,7 +12,7 @@ from metainterface._names import (
     METHOD_NAMES,
     MODEL_NAMES,
 )
-from metainterface.cli._design_options import command, manufacturing, settings, verify
+from metainterface.cli._design_options import command, groups, settings, verify
 from metainterface.cli._design_report import table
 from metainterface.cli.common import add_device, positive_int
 
@@ -293,10 +293,8 @@ def _design_scale(args: argparse.Namespace, options: dict) -> list:
     ]
     if missing:
         raise mi.MetainterfaceError(f"--friction-csv needs {', '.join(missing)}")
-    for key in ("modulus", "radius", "area"):  # the scale search sets them
-        options.pop(key)
-    if args.total_force is None:
-        options.pop("total_force")
+    # the scale search sets the modulus, radius and area; a total force stays the user's
+    options["scale"] = mi.Scale(total_force=args.total_force)
     r = mi.design_scale(
         args.friction_csv,
         shear_strength=args.shear_strength,
@@ -325,28 +323,20 @@ def run(args: argparse.Namespace) -> int:
 
     targets = [] if args.friction_csv and _scale_free(args) else _targets(args)
     options = dict(
-        refine=args.refine == "lbfgs",
-        surrogate=args.model,
-        starts=args.starts,
-        seed=args.seed,
         model=args.physics,
-        hedge=args.hedge,
-        fallback=args.fallback,
         max_pressure=args.max_pressure,
-        modulus=args.modulus,
-        radius=args.radius,
-        total_force=args.total_force,
-        area=args.area if args.total_force is None else None,
         settings=settings(args),
-        meta=command(args),
         full_target=args.full_target,
         device=args.device,
         force=args.force,
         verify=verify(args),
-        **manufacturing(args),
+        **groups(args),
     )
+    from metainterface._files.provenance import recording_command
+
     try:
-        results = _run(args, targets, options)
+        with recording_command(command(args)):  # design.json records the command line
+            results = _run(args, targets, options)
     except mi.UnreachableError as exc:  # two lines: what is out of reach, what would fix it
         head, _, advice = exc.reachability.message.partition("\n")
         print(f"metainterface design: error: {exc.target}: {head}", file=sys.stderr)

@@ -1,14 +1,17 @@
 """Option groups of :func:`~metainterface.design`: small frozen values a user builds once and
 passes to every design (``mi.design(t, scale=..., robust=..., effort=...)``).
 
-Each group stands for keywords :func:`~metainterface.design` also takes one by one (the
-command line's options map to those); a group and one of its own keywords in the same call
-is refused, so that no value silently wins. The values are checked where they are used, with
-the same one-line errors as the keywords.
+The groups are the one way to give these options. The keywords they replace (``starts=``,
+``radius=``, ``sigma_h=``, ...) are still read for one release, each call that uses them
+warned with a :class:`DeprecationWarning` naming the group to use; a group and one of its
+own old keywords in the same call is refused, so that no value silently wins. The values
+are checked where they are used, with the same one-line errors as before.
 """
 
 from __future__ import annotations
 
+import os
+import warnings
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -92,11 +95,14 @@ class Robust:
 
 @dataclass(frozen=True)
 class Effort:
-    """How hard a design searches: its starts, the surrogate's hedge and fallback, the
+    """How hard a design searches: its starts, the surrogate and its hedge and fallback, the
     refinement and the seed.
 
     Attributes
     ----------
+    surrogate : path or None
+        The surrogate model file the surrogate method predicts with (``metainterface
+        train``); None: the shipped one.
     starts : int
         Random starts of the multistart and Hertz methods, in [1, 10000].
     hedge : int
@@ -133,11 +139,61 @@ class Effort:
     seed: int = 0
     refine_settings: RefineSettings | None = None
     hedge_error: float = HEDGE_ERROR
+    surrogate: str | os.PathLike[str] | None = None
 
 
-#: The keyword of :func:`~metainterface.design` that each group's field stands for (where
-#: the two names differ).
+#: The old keyword of :func:`~metainterface.design` that each group's field stands for
+#: (where the two names differ).
 KEYWORDS: dict[type, dict[str, str]] = {Robust: {"samples": "robust_samples"}}
+#: The group each old keyword now lives in, and the argument that takes the group.
+OLD_KEYWORDS: dict[str, tuple[type, str]] = {
+    **{
+        k: (Effort, "effort")
+        for k in ("starts", "hedge", "fallback", "refine", "seed", "refine_settings", "surrogate")
+    },
+    **{k: (Scale, "scale") for k in ("radius", "modulus", "total_force", "area")},
+    **{k: (Robust, "robust") for k in ("sigma_h", "sigma_gamma", "scale_sigma", "robust_samples")},
+}
+
+
+def option_groups(
+    old: dict[str, Any], effort: Any, scale: Any, robust: Any, caller: str = "design"
+) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
+    """The fields of the three groups (``merge``'d), with the old keywords ``old`` read in
+    for one release and warned about once per call.
+
+    Raises MetainterfaceError on a keyword that never was one of ``caller``'s.
+    """
+    unknown = sorted(k for k in old if k not in OLD_KEYWORDS)
+    if unknown:
+        raise MetainterfaceError(
+            f"{caller}() got an unexpected keyword {unknown[0]!r}", argument=unknown[0]
+        )
+
+    def pick(kind: type) -> dict[str, Any]:
+        return {k: old.get(k) for k, (g, _) in OLD_KEYWORDS.items() if g is kind}
+
+    groups = (
+        merge(effort, Effort, "effort", pick(Effort)),
+        merge(scale, Scale, "scale", pick(Scale)),
+        merge(robust if isinstance(robust, Robust) else None, Robust, "robust", pick(Robust)),
+    )
+    given = {k: v for k, v in old.items() if v is not None}
+    if given:
+        by_group: dict[str, list[str]] = {}
+        for k in given:
+            kind, arg = OLD_KEYWORDS[k]
+            field = {v: f for f, v in KEYWORDS.get(kind, {}).items()}.get(k, k)
+            by_group.setdefault(f"{arg}=mi.{kind.__name__}", []).append(f"{field}=...")
+        advice = "; ".join(f"{g}({', '.join(fs)})" for g, fs in by_group.items())
+        warnings.warn(
+            f"{caller}({', '.join(f'{k}=' for k in given)}) is deprecated and will be "
+            f"removed: pass {advice}",
+            DeprecationWarning,
+            stacklevel=4,
+        )
+
+    return groups
 
 
 def merge(group: Any, kind: type, argument: str, given: dict[str, Any]) -> dict[str, Any]:
@@ -167,3 +223,15 @@ def merge(group: Any, kind: type, argument: str, given: dict[str, Any]) -> dict[
         kw: getattr(group, name) if given.get(kw) is None else given[kw]
         for name, kw in names.items()
     }
+
+
+def as_groups(
+    knobs: dict[str, Any], size: dict[str, Any], errors: dict[str, Any], robust: Any
+) -> dict[str, Any]:
+    """``option_groups``' fields back as the arguments ``effort``, ``scale`` and ``robust``."""
+    if robust is True or isinstance(robust, Robust):
+        rename = KEYWORDS[Robust]
+        robust = Robust(**{f.name: errors[rename.get(f.name, f.name)] for f in fields(Robust)})
+    elif any(errors[k] not in (None, 0, 0.0) for k in ("sigma_h", "sigma_gamma", "scale_sigma")):
+        raise MetainterfaceError("sigma_h, sigma_gamma and scale_sigma need robust=True")
+    return {"effort": Effort(**knobs), "scale": Scale(**size), "robust": robust}

@@ -13,10 +13,18 @@ from typing import Any
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
+from metainterface._files.provenance import current_command
 from metainterface._threads import uses_threads
 from metainterface.designer.curves import reach_note
 from metainterface.designer.given import _limit, _physical_options
-from metainterface.designer.options import Effort, Robust, Scale, merge
+from metainterface.designer.options import (
+    OLD_KEYWORDS,
+    Effort,
+    Robust,
+    Scale,
+    as_groups,
+    option_groups,
+)
 from metainterface.designer.results import DesignResult
 from metainterface.designer.robust import _manufacturing, _printable_record, _robust_stats
 from metainterface.errors import MetainterfaceError
@@ -80,7 +88,6 @@ def design(
     method: str = "surrogate",
     model: str | ForwardModel | None = None,
     settings: CellSettings | None = None,
-    surrogate: str | os.PathLike[str] | None = None,
     effort: Effort | None = None,
     scale: Scale | None = None,
     robust: bool | Robust = False,
@@ -91,94 +98,35 @@ def design(
     device: str = "auto",
     out: str | os.PathLike[str] | None = None,
     full_target: bool = False,
-    meta: dict[str, Any] | None = None,
-    starts: int | None = None,
-    hedge: int | None = None,
-    fallback: int | None = None,
-    refine: bool | None = None,
-    seed: int | None = None,
-    refine_settings: RefineSettings | None = None,
-    radius: str | float | None = None,
-    modulus: str | float | None = None,
-    total_force: str | float | None = None,
-    area: str | float | None = None,
-    sigma_h: float | str | None = None,
-    sigma_gamma: float | None = None,
-    scale_sigma: float | None = None,
-    robust_samples: int | None = None,
+    **deprecated: Any,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target, checked in BEM.
 
-    ``mi.design(t)`` is enough; the options come in groups (built once, reused)::
+    ``mi.design(t)`` is enough; options come in groups, built once and reused::
 
         mi.design(t, effort=mi.Effort(starts=8, seed=1),
                   scale=mi.Scale(radius="0.5mm", modulus="2MPa", area="4cm2"),
                   robust=mi.Robust(sigma_h="1um", samples=8), z_step="10um")
 
-    Parameters
-    ----------
-    targets : Target, str or list of them
-        A target, a built-in name (``"bilinear"``, ...), or a list (designed in one batch;
-        a list of results back).
-    method : {"surrogate", "multistart", "hertz"}
-        The surrogate's prediction then refinement (default), random starts refined, or the
-        Hertz-only baseline (gamma = 2).
-    model : str or ForwardModel
-        Forward model: ``"independent"`` (default), ``"interacting"`` or an instance.
-    settings : CellSettings
-        The design space (N, gamma bounds, Delta_max); the default is the paper's cell.
-    surrogate : path
-        A surrogate model file (``metainterface train``), default the shipped one.
-    effort : Effort
-        Starts, hedge, fallback, refine, seed and refine_settings (see :class:`Effort`).
-    scale : Scale
-        Radius, modulus, total_force or area in SI (see :class:`Scale`).
-    robust : bool or Robust
-        Design for a printer's errors (see :class:`Robust`).
-    max_pressure : float or str
-        A peak pressure limit: p/E* in (0, 1], or a stress ('50MPa') with a modulus.
-    z_step : float or str
-        A printer's layer height (units of R, or '1um' with a radius): the heights are
-        snapped to it and the gammas re-refined; ``result.printable`` reports the errors.
-    verify : bool or Verify
-        Check (and correct) each design in BEM (default ``Verify()``); False skips it.
-    force : bool
-        Design a friction law no cell can follow anyway (the closest cell, ``result.forced``);
-        without it such a target raises :class:`~metainterface.UnreachableError`.
-    device : str
-        ``"auto"``, ``"cpu"``, ``"cuda"`` or ``"cuda:N"``. "auto" refines on the CPU (faster
-        than a GPU for a design's small steps) and runs the BEM check on CUDA when torch
-        sees it.
-    out : path
-        Write each result's files here (several targets: ``out/<name>``).
-    full_target, meta
-        With ``out``: also the whole target in target.csv; extra keys for design.json.
-    starts, hedge, fallback, refine, seed, refine_settings
-        One by one, the fields of ``effort``.
-    radius, modulus, total_force, area
-        One by one, the fields of ``scale``.
-    sigma_h, sigma_gamma, scale_sigma, robust_samples
-        One by one, the fields of a ``Robust`` (``robust_samples`` is its ``samples``),
-        with ``robust=True``.
+    targets: a Target, a built-in name ("bilinear", ...) or a list of them (one batch, a
+    list of results back). method: "surrogate" (prediction, then refinement), "multistart"
+    or "hertz" (gamma = 2). model: "independent" (default), "interacting" or a
+    ForwardModel. settings: the CellSettings design space (default: the paper's cell).
+    effort, scale, robust: the search (Effort), the user's scale in SI (Scale), a design
+    for a printer's errors (Robust, or True). max_pressure: a peak pressure limit, p/E* in
+    (0, 1] or a stress ('50MPa') with a modulus. z_step: a printer's layer height (units
+    of R, or '10um' with a radius). verify: check and correct each design in BEM (True, a
+    Verify, or False). force: design a law no cell can follow (else UnreachableError).
+    device: "auto" (refinement on the CPU, the BEM check on CUDA when torch sees it),
+    "cpu", "cuda" or "cuda:N". out: write each result's files there (several targets:
+    out/<name>); full_target: also the whole target in target.csv.
 
-    Returns
-    -------
-    DesignResult or list of DesignResult
-        One per target, in order.
+    The old one-by-one keywords (starts=, radius=, sigma_h=, ...) still work for one
+    release, with a DeprecationWarning naming their group.
+
+    Returns one DesignResult per target (one, not a list, for a single target).
     """
-    knobs = merge(
-        effort,
-        Effort,
-        "effort",
-        {
-            "starts": starts,
-            "hedge": hedge,
-            "fallback": fallback,
-            "refine": refine,
-            "seed": seed,
-            "refine_settings": refine_settings,
-        },
-    )
+    knobs, size, errors = option_groups(deprecated, effort, scale, robust)
     starts, hedge, fallback, refine, seed = (
         knobs["starts"],
         knobs["hedge"],
@@ -186,30 +134,13 @@ def design(
         knobs["refine"],
         knobs["seed"],
     )
-    refine_settings = knobs["refine_settings"]
-    hedge_error = knobs["hedge_error"]
-    size = merge(
-        scale,
-        Scale,
-        "scale",
-        {"radius": radius, "modulus": modulus, "total_force": total_force, "area": area},
-    )
+    refine_settings, hedge_error = knobs["refine_settings"], knobs["hedge_error"]
+    surrogate = knobs["surrogate"]
     radius, modulus, total_force, area = (
         size["radius"],
         size["modulus"],
         size["total_force"],
         size["area"],
-    )
-    errors = merge(
-        robust if isinstance(robust, Robust) else None,
-        Robust,
-        "robust",
-        {
-            "sigma_h": sigma_h,
-            "sigma_gamma": sigma_gamma,
-            "scale_sigma": scale_sigma,
-            "robust_samples": robust_samples,
-        },
     )
     robust = True if isinstance(robust, Robust) else robust
     items, single = _targets(targets)
@@ -296,7 +227,7 @@ def design(
     if out is not None:
         out = Path(out)
         folders = [out] if single else [out / r.target.name for r in results]
-        _save_all(results, folders, physical, meta, full_target)
+        _save_all(results, folders, physical, full_target)
     return results[0] if single else results
 
 
@@ -411,12 +342,12 @@ def _save_all(
     results: list[DesignResult],
     folders: list[Path],
     physical: dict | None,
-    meta: dict[str, Any] | None,
     full_target: bool = False,
 ) -> None:
     with output_set():  # every result's files, or none
         for r, folder in zip(results, folders, strict=True):
-            extra = {"command": meta} if meta else {}
+            command = current_command()
+            extra = {"command": command} if command else {}
             if physical is not None:
                 extra["physical"] = physical_block(r.design, **physical)
             r.save(folder, full_target=full_target, **extra)
@@ -440,13 +371,18 @@ def compare(
         check_output_folder(out)
     if "method" in options:
         raise MetainterfaceError("compare runs every method; leave method out")
-    meta = options.pop("meta", None)
     full_target = options.pop("full_target", False)
-    given = {k: options.pop(k, None) for k in ("radius", "modulus", "total_force", "area")}
-    size = merge(options.pop("scale", None), Scale, "scale", given)
+    old = {k: options.pop(k) for k in list(options) if k in OLD_KEYWORDS}
+    groups = option_groups(
+        old,
+        options.pop("effort", None),
+        options.pop("scale", None),
+        options.get("robust"),
+        "compare",
+    )
+    options.update(as_groups(*groups, options.get("robust", False)))
+    size = groups[1]
     physical = _physical_options(size["radius"], size["modulus"], size["total_force"], size["area"])
-    if size["modulus"] is not None:  # the designs read a stress max_pressure against it
-        options["modulus"] = size["modulus"]
     by_method = {
         m: design(items, method=m, **options)  # type: ignore[misc]
         for m in pipeline.METHODS
@@ -459,7 +395,7 @@ def compare(
             for i, t in enumerate(items):
                 per = [by_method[m][i] for m in pipeline.METHODS]
                 base = out if single else out / t.name
-                _save_all(per, [base / r.method for r in per], physical, meta, full_target)
+                _save_all(per, [base / r.method for r in per], physical, full_target)
                 fig = plot_comparison([per], [[r.curve() for r in per]])
                 save_figure(fig, base / "compare.png", command="compare")
     return by_method  # type: ignore[return-value]

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from metainterface._threads import uses_threads
-from metainterface.designer.options import Effort
+from metainterface.designer.options import OLD_KEYWORDS, Effort, as_groups, option_groups
 from metainterface.errors import MetainterfaceError, UnitSlipWarning
 from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
@@ -282,17 +282,24 @@ def design_scale(
             p_star=ft.p_star, alpha=ft.alpha, name=label, source=source, meta={"friction": record}
         )
 
-    quick_opts = {k: v for k, v in options.items() if k in ("method", "seed", "model", "hedge")}
+    knobs, size, made_errors = option_groups(
+        {k: options.pop(k) for k in list(options) if k in OLD_KEYWORDS},
+        options.pop("effort", None),
+        options.pop("scale", None),
+        options.get("robust"),
+        "design_scale",
+    )
     effort = Effort(
-        hedge=Effort.hedge if quick_opts.get("hedge") is None else quick_opts["hedge"],
-        seed=Effort.seed if quick_opts.get("seed") is None else quick_opts["seed"],
+        hedge=knobs["hedge"],
+        seed=knobs["seed"],
+        surrogate=knobs["surrogate"],
         fallback=0,
         refine_settings=QUICK,
         # a candidate's design is rarely within Effort.hedge_error: its hedges are refined
         # with its prediction in one batch, not after it
         hedge_error=0.0,
     )
-    quick_opts = {k: v for k, v in quick_opts.items() if k in ("method", "model")}
+    quick_opts = {k: v for k, v in options.items() if k in ("method", "model")}
 
     def quick(vals: np.ndarray) -> np.ndarray:
         made = design(
@@ -333,12 +340,13 @@ def design_scale(
             },
         },
     )
-    phys = {"modulus": at["modulus"], "radius": at["radius"]}
-    if "total_force" not in options:
-        phys["area"] = at["area"]
+    size = {**size, "modulus": at["modulus"], "radius": at["radius"]}
+    if size["total_force"] is None:
+        size["area"] = at["area"]
+    options.update(as_groups(knobs, size, made_errors, options.get("robust", False)))
     with warnings.catch_warnings():  # a unit slip was said once, above
         warnings.simplefilter("ignore", UnitSlipWarning)
-        return design(t, settings=settings, **phys, **options)
+        return design(t, settings=settings, **options)
 
 
 def scale_line(result: Any) -> str | None:

@@ -75,7 +75,7 @@ def train_surrogate(
 ) -> TrainResult:
     """Train the inverse network on a dataset (``generate_dataset``) into the run folder
     ``out``: one atomic checkpoint per epoch (``resume=True`` continues), the best model as
-    ``out/model.pt``, usable as ``design(..., surrogate=out / "model.pt")``. With
+    ``out/model.pt``, usable as ``design(..., effort=Effort(surrogate=out / "model.pt"))``. With
     ``config.reads == "laws"`` it trains on targets made from the dataset's cells the way
     friction laws arrive (``metainterface.surrogate.laws``), usually from ``config.init``,
     the shipped network (``TrainConfig.laws()``). ``device``
