@@ -21,6 +21,7 @@ Designing
     design, compare, DesignResult, pressure_check, physical, reachability (can a cell
     follow this friction law at this E*, tau and area?), Reachability, UnreachableError,
     UnitSlipWarning (a modulus, shear strength or radius that looks like a unit slip),
+    ReachWarning (a target partly out of reach, said before a design starts),
     feasible_scale (which area, E* or tau makes a friction law reachable, FeasibleScale),
     design_scale (a friction law designed with its area, E* or tau chosen too)
 Design options
@@ -103,6 +104,7 @@ _HOMES: dict[str, str] = {
     "MetainterfaceError": "metainterface.errors",
     "UnreachableError": "metainterface.errors",
     "UnitSlipWarning": "metainterface.errors",
+    "ReachWarning": "metainterface.errors",
     "Reachability": "metainterface.units.reach",
     "reachability": "metainterface.inverse.reach",
     "Target": "metainterface.inverse.targets",
@@ -131,7 +133,12 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.designer.results import DesignResult
     from metainterface.designer.run import compare, design
     from metainterface.designer.view import view
-    from metainterface.errors import MetainterfaceError, UnitSlipWarning, UnreachableError
+    from metainterface.errors import (
+        MetainterfaceError,
+        ReachWarning,
+        UnitSlipWarning,
+        UnreachableError,
+    )
     from metainterface.inverse.reach import reachability
     from metainterface.inverse.targets import Target
     from metainterface.manufacture.sizing import PrinterSizing, min_radius
@@ -203,6 +210,7 @@ __all__ = [
     "Interacting",
     "MetainterfaceError",
     "PrinterSizing",
+    "ReachWarning",
     "Reachability",
     "Robust",
     "Scale",

@@ -29,6 +29,12 @@ class UnreachableError(MetainterfaceError):
         self.target = target
 
 
+class ReachWarning(UserWarning):
+    """A target partly outside what a cell reaches (the one reach test of ``reachability``
+    and ``feasible_scale``): ``design`` says so once per target, before it starts the work,
+    and then designs the closest cell (its ``notes`` keep the same lines)."""
+
+
 class UnitSlipWarning(UserWarning):
     """A modulus, shear strength or radius that reads as a quantity but is almost surely in
     the wrong unit (``modulus=2.4`` is 2.4 Pa, not 2.4 MPa). The message names the value and

@@ -120,23 +120,25 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 @contextlib.contextmanager
 def _unit_slips_in_one_line(args: argparse.Namespace) -> Iterator[None]:
-    """Show each unit-slip warning (``--modulus 2.4`` read as 2.4 Pa) once, as one line on
-    stderr: ``metainterface design: warning: modulus 2.4 Pa is below 1 kPa: ...``. The same
-    value is checked on every path that reads it (the law, its feasible scale, the design)."""
-    from metainterface.errors import UnitSlipWarning
+    """Show each unit-slip warning (``--modulus 2.4`` read as 2.4 Pa) and each reach warning
+    (a target partly out of reach) once, as one line on stderr: ``metainterface design:
+    warning: modulus 2.4 Pa is below 1 kPa: ...``. The same value is checked on every path
+    that reads it (the law, its feasible scale, the design)."""
+    from metainterface.cli.common import SHOWN
+    from metainterface.errors import ReachWarning, UnitSlipWarning
 
-    shown: set[str] = set()
     default = warnings.showwarning
 
     def show(message: Any, category: type, *rest: Any, **kw: Any) -> None:
-        if not issubclass(category, UnitSlipWarning):
+        if not issubclass(category, UnitSlipWarning | ReachWarning):
             default(message, category, *rest, **kw)
-        elif str(message) not in shown:
-            shown.add(str(message))
+        elif str(message) not in SHOWN:
+            SHOWN.add(str(message))
             print(f"metainterface {args.command}: warning: {message}", file=sys.stderr)
 
     with warnings.catch_warnings():
         warnings.simplefilter("always", UnitSlipWarning)
+        warnings.simplefilter("always", ReachWarning)
         warnings.showwarning = show
         yield
 

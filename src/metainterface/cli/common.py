@@ -5,6 +5,10 @@ from __future__ import annotations
 import argparse
 import math
 
+#: The one-line warnings this command has printed (each printed once; the notes that repeat
+#: one are not printed again).
+SHOWN: set[str] = set()
+
 
 def positive_int(text: str) -> int:
     try:

@@ -14,7 +14,7 @@ from metainterface._names import (
 )
 from metainterface.cli._design_options import command, groups, settings, verify
 from metainterface.cli._design_report import table
-from metainterface.cli.common import add_device, positive_int
+from metainterface.cli.common import SHOWN, add_device, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -344,7 +344,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     for r in results:
         for note in r.notes:
-            print(f"warning: {note}", file=sys.stderr)
+            if not any(note in said for said in SHOWN):  # said once already, before the work
+                print(f"warning: {note}", file=sys.stderr)
         if r.pressure is not None:
             print(f"{r.target.name} ({r.method}): {r.pressure.summary()}")
     table(args, results)

@@ -5,6 +5,7 @@ MetainterfaceError."""
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -27,8 +28,9 @@ from metainterface.designer.options import (
 )
 from metainterface.designer.results import DesignResult
 from metainterface.designer.robust import _manufacturing, _printable_record, _robust_stats
-from metainterface.errors import MetainterfaceError
+from metainterface.errors import MetainterfaceError, ReachWarning
 from metainterface.inverse import pipeline
+from metainterface.inverse.envelope import reachability_warnings
 from metainterface.inverse.perturb import Perturbation
 from metainterface.inverse.reach import refuse_unreachable
 from metainterface.inverse.refine import RefineSettings
@@ -149,6 +151,7 @@ def design(
     if settings is not None and not isinstance(settings, CellSettings):
         raise MetainterfaceError("settings must be a CellSettings")
     reach = refuse_unreachable(items, settings, force)  # before any work or file
+    _say_reach(items, settings or CellSettings(), reach)
     if out is not None:  # before any work: a bad folder should not cost a design run
         check_output_folder(out)
     _checks.choice("method", method, pipeline.METHODS)
@@ -297,6 +300,19 @@ def _verify_all(
     return out
 
 
+def _say_reach(items: list[Target], settings: CellSettings, reach: dict[str, Any]) -> None:
+    """One ReachWarning per target the reach test finds partly out of reach, before the
+    work starts (a friction law out of reach got here only with force=True)."""
+    for t in items:
+        lines = reachability_warnings(t, settings)
+        if t.name in reach and not reach[t.name].reachable:
+            lines = [f"friction law {t.name}: " + reach[t.name].message.replace("\n", " ")]
+        if lines:
+            warnings.warn(
+                "; ".join(lines) + "; designing the closest cell", ReachWarning, stacklevel=4
+            )
+
+
 def _pressure(d: Design, limit: float | None, modulus: Any) -> PressureCheck | None:
     if limit is None:
         return None
@@ -306,7 +322,7 @@ def _pressure(d: Design, limit: float | None, modulus: Any) -> PressureCheck | N
 
 def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> DesignResult:
     d = Design(gamma=r.gamma, h=r.h, settings=r.settings)
-    notes = (*r.notes, *pipeline.reachability_warnings(r.target, r.settings))
+    notes = (*r.notes, *reachability_warnings(r.target, r.settings))
     pressure = _pressure(d, limit, modulus)
     out = DesignResult(
         target=r.target,

@@ -1,14 +1,12 @@
 """Inverse design: targets, parameterisations, the batched multi-stage refinement, the pipeline."""
 
-from metainterface.inverse.params import FULL, HERTZ, Parameterisation
-from metainterface.inverse.pipeline import (
-    METHODS,
-    DesignResult,
-    design,
-    predict,
+from metainterface.inverse.envelope import (
+    reach_violation,
     reachability_warnings,
     reachable_envelope,
 )
+from metainterface.inverse.params import FULL, HERTZ, Parameterisation
+from metainterface.inverse.pipeline import METHODS, DesignResult, design, predict
 from metainterface.inverse.refine import RefineSettings, TargetGrid, relative_error
 from metainterface.inverse.targets import (
     BUILTIN_TARGETS,
@@ -31,6 +29,7 @@ __all__ = [
     "builtin_target",
     "design",
     "predict",
+    "reach_violation",
     "reachability_warnings",
     "reachable_envelope",
     "relative_error",

@@ -8,7 +8,6 @@ independent problems.
 
 from __future__ import annotations
 
-import functools
 import os
 import time
 import warnings
@@ -51,7 +50,6 @@ from metainterface.inverse.starts import (
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.models import ForwardModel, get_model
-from metainterface.physics.pressures import alpha_at
 
 #: Design methods and the parameterisation each refines: the surrogate's prediction and the
 #: multistart in the full space, the Hertz-only baseline with gamma fixed at 2.
@@ -459,69 +457,3 @@ def _usable_method(
         "(train a surrogate for this cell to use one)"
     )
     return "multistart", (note,)
-
-
-def reachable_envelope(
-    p_star: np.ndarray, settings: CellSettings, samples: int = 2000, seed: int = 0
-) -> tuple[np.ndarray, np.ndarray, float]:
-    """An estimate of the alpha range reachable at each pressure (M,): (lo, hi, P*_reach).
-
-    From a fixed family of designs: uniform cells over a gamma grid at h = 0, single active
-    asperities, and ``samples`` random cells; P*_reach is the largest pressure any reaches.
-    The envelope is computed once per cell on a fine pressure grid and interpolated (lo = inf,
-    hi = -inf beyond P*_reach).
-    """
-    grid, lo, hi, reach = _envelope(settings, samples, seed)
-    p = np.asarray(p_star, dtype=np.float64)
-    inside = p <= reach
-    lo_q = np.where(inside, np.interp(p, grid, lo), np.inf)
-    hi_q = np.where(inside, np.interp(p, grid, hi), -np.inf)
-    return lo_q, hi_q, reach
-
-
-@functools.lru_cache(maxsize=8)
-def _envelope(
-    settings: CellSettings, samples: int, seed: int, points: int = 256
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """The family's envelope on ``points`` pressures over [0, P*_reach]."""
-    n = settings.n_asperities
-    gammas = torch.linspace(settings.gamma_min, settings.gamma_max, 12, dtype=DTYPE)
-    uniform = gammas[:, None].expand(-1, n)
-    single_h = torch.full((12, n), 3 * settings.delta_max, dtype=DTYPE)
-    single_h[:, 0] = 0.0
-    g_r, h_r = random_starts(samples, 1, settings, seed, FULL)
-    gamma = torch.cat([uniform, uniform, g_r])
-    h = torch.cat([torch.zeros(12, n, dtype=DTYPE), single_h, h_r])
-    with torch.no_grad():
-        p_max = alpha_at(gamma, h, settings, torch.zeros(gamma.shape[0], 1, dtype=DTYPE))[1]
-        reach = float(p_max.max())
-        # denser near 0, where every curve rises steeply (alpha ~ P*^(2/gamma))
-        grid = reach * torch.linspace(0.0, 1.0, points, dtype=DTYPE) ** 2
-        alpha, _ = alpha_at(gamma, h, settings, grid[None].expand(gamma.shape[0], -1))
-    reached = grid[None] <= p_max[:, None]
-    lo = torch.where(reached, alpha, torch.inf).amin(0)
-    hi = torch.where(reached, alpha, -torch.inf).amax(0)
-    return grid.numpy(), lo.numpy(), hi.numpy(), reach
-
-
-def reachability_warnings(
-    target: Target, settings: CellSettings, tolerance: float = 0.05
-) -> list[str]:
-    """Human-readable warnings where the target leaves the reachable envelope."""
-    lo, hi, p_reach = reachable_envelope(target.p_star, settings)
-    out = []
-    if target.p_star_max > p_reach:
-        out.append(
-            f"target {target.name}: P* = {target.p_star_max:.4g} is beyond the largest pressure "
-            f"any design in the bounds reaches at Delta_max ({p_reach:.4g})"
-        )
-    ok = np.isfinite(lo) & (target.p_star > 0)
-    outside = ok & ((target.alpha < lo * (1 - tolerance)) | (target.alpha > hi * (1 + tolerance)))
-    if outside.any():
-        i = int(np.flatnonzero(outside)[0])
-        out.append(
-            f"target {target.name}: alpha = {target.alpha[i]:.4g} at P* = {target.p_star[i]:.4g} "
-            f"is outside the reachable envelope there, alpha in [{lo[i]:.4g}, {hi[i]:.4g}] "
-            f"({int(outside.sum())} of {target.p_star.size} points outside)"
-        )
-    return out

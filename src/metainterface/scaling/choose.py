@@ -102,7 +102,7 @@ def _reference(law: Any, given: dict[str, float], var: str | None) -> dict[str, 
     the cell's largest reachable P* (area, modulus) or alpha = 0.02 (tau)."""
     if var is None or math.isfinite(given[var]):
         return given
-    from metainterface.inverse.pipeline import reachable_envelope
+    from metainterface.inverse.envelope import reachable_envelope
 
     _, _, reach = reachable_envelope(np.zeros(1), CellSettings())
     fn, ff = float(law.normal_force.max()), float(law.friction_force.max())

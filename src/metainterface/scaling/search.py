@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from metainterface.errors import MetainterfaceError
-from metainterface.inverse.pipeline import reachable_envelope
+from metainterface.inverse.envelope import TOLERANCE, reach_violation
 from metainterface.physics.cell import CellSettings
 
 #: The scale variables: how a factor k on each moves the target (P*, alpha).
@@ -30,8 +30,6 @@ VARIABLES = ("area", "modulus", "shear_strength")
 #: step: finer than any unit the ranges are reported in).
 DECADES = 3.0
 PER_DECADE = 230
-#: Relative slack on the envelope, as the reachability warnings use.
-TOLERANCE = 0.05
 
 
 def _moved(p: np.ndarray, a: np.ndarray, variable: str, k: np.ndarray) -> tuple[Any, Any]:
@@ -48,16 +46,9 @@ def violation(
     p_star: np.ndarray, alpha: np.ndarray, settings: CellSettings, tolerance: float = TOLERANCE
 ) -> tuple[np.ndarray, np.ndarray]:
     """How far targets (S, K) leave the reachable envelope: (mean violation (S,), points
-    outside (S,)). A point's violation is the log-ratio by which it misses the envelope
-    (0 inside); beyond the largest reachable P*, the log-ratio of its pressure to that."""
-    lo, hi, reach = reachable_envelope(p_star, settings)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a = np.maximum(alpha, 1e-300)
-        below = np.log(np.maximum(lo * (1 - tolerance) / a, 1.0))
-        above = np.log(np.maximum(a / (hi * (1 + tolerance)), 1.0))
-        beyond = np.log(np.maximum(p_star / reach, 1.0))
-        v = np.where(p_star > reach, beyond + 1.0, below + above)
-    v = np.where(p_star > 0, v, 0.0)
+    outside (S,)), from the one reach test (:func:`~metainterface.inverse.envelope.
+    reach_violation`) that ``reachability`` and ``design`` ask too."""
+    v = reach_violation(p_star, alpha, settings, tolerance)
     return v.mean(-1), (v > 0).sum(-1)
 
 

@@ -16,9 +16,11 @@ Delta_max with the gamma of the largest force.
 
 So at a pressure P* the reachable friction coefficient is [lo, hi] / P* times tau / E*:
 changing tau / E* scales the law's mu against it, and a larger area lowers the law's P*
-(which moves it along these bounds). Pointwise bounds are necessary, not sufficient (one
-cell must follow the whole law); a slack of ``TOLERANCE`` times the law's largest alpha is
-allowed before a point counts as out of reach.
+(which moves it along these bounds). These exact bounds (:func:`alpha_bounds`) let each
+asperity pick its gamma anew at every load, which no one cell does, so they are wider than
+what a cell follows. :func:`reachability` therefore asks the one reach test the design
+asks too (:func:`~metainterface.inverse.envelope.reach_violation`: the envelope of a
+family of cells), and reports mu in its terms.
 Closed forms (Sneddon, :mod:`metainterface.physics.sneddon`): for one asperity pressed by d,
 a = (d / (kappa c))^(1/gamma), F = 2 gamma / (gamma + 1) d a, A = pi a^2.
 """
@@ -39,8 +41,6 @@ from metainterface.physics.sneddon import log_kc
 GAMMA_SAMPLES = 129
 #: Forces sampled per asperity, 0 to the largest one asperity carries.
 FORCE_SAMPLES = 256
-#: Relative slack on the bounds before a law's point counts as out of reach.
-TOLERANCE = 0.05
 
 
 def alpha_bounds(
@@ -169,14 +169,18 @@ def reachability(
     fn, ff = fn[keep], ff[keep]
     p = fn / (area * e_star)
     alpha = ff / (shear_strength * area)
-    lo, hi, p_reach = alpha_bounds(p, settings)
+    # the one reach test (feasible_scale and design ask it too); imported here because
+    # metainterface.inverse imports this module
+    from metainterface.inverse.envelope import reach_violation, reachable_envelope
+
+    cell = settings or CellSettings()
+    lo, hi, p_reach = reachable_envelope(p, cell)
     to_mu = shear_strength / e_star  # mu = (alpha / P*) tau / E*
     law_mu = ff / fn
     within = p <= p_reach
     f_reach = p_reach * area * e_star
     coverage = float(min(1.0, f_reach / fn.max()))
-    slack = TOLERANCE * alpha.max()  # in units of the law's scale, as the curve error
-    ok = within & (alpha >= lo - slack) & (alpha <= hi + slack)
+    ok = reach_violation(p, alpha, cell) == 0
     reachable = bool(ok.all())
     if within.any():
         mu_lo, mu_hi = lo[within] / p[within] * to_mu, hi[within] / p[within] * to_mu
@@ -207,7 +211,7 @@ def reachability(
             f"{f_reach:.3g}{force_unit} only.\n"
         )
     if not reachable:
-        message += _advice(p, alpha, lo, hi, within, slack, f_reach, fn, shear_strength, units)
+        message += _advice(p, alpha, lo, hi, within, f_reach, fn, shear_strength, units)
     return Reachability(
         reachable=reachable,
         law_mu=(float(law_mu.min()), float(law_mu.max())),
@@ -229,12 +233,15 @@ def _pa(value: float) -> str:
     return f"{value:.3g} Pa"
 
 
-def _advice(p, alpha, lo, hi, within, slack, f_reach, fn, tau, units) -> str:
+def _advice(p, alpha, lo, hi, within, f_reach, fn, tau, units) -> str:
     """What would make the law reachable: a shear strength (the law's alpha scaled by s,
     tau' = tau / s) where one exists at these loads, and a larger area where its loads
     exceed the cell's."""
     out = []
     if within.any():
+        from metainterface.inverse.envelope import TOLERANCE
+
+        slack = TOLERANCE * alpha.max()
         a, low, high = alpha[within], lo[within], hi[within]
         s_lo = float(np.max(low / (a + slack)))
         big = a > slack
