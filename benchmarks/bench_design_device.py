@@ -20,7 +20,7 @@ from pathlib import Path
 import torch
 
 import metainterface as mi
-from metainterface.surrogate.train import TrainConfig
+from metainterface.surrogate.config import TrainConfig
 
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_design import realisable_targets

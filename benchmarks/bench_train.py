@@ -25,8 +25,9 @@ import torch
 from metainterface.data import generate_dataset, load_dataset
 from metainterface.physics import CellSettings
 from metainterface.runtime import tune_allocator
+from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
-from metainterface.surrogate.train import TrainConfig, read_metrics, train
+from metainterface.surrogate.train import read_metrics, train
 
 
 def _minor_faults() -> int:

@@ -19,7 +19,7 @@ import metainterface as mi
 from metainterface.data import load_dataset
 from metainterface.inverse.refine import RefineSettings
 from metainterface.surrogate.checkpoint import load_model, load_torch
-from metainterface.surrogate.train import TrainConfig
+from metainterface.surrogate.config import TrainConfig
 
 pytestmark = [
     pytest.mark.cuda,
@@ -91,7 +91,7 @@ def test_cuda_training_is_bitwise_repeatable_with_deterministic_algorithms(tmp_p
     mi.generate_dataset(600, tmp_path / "d.npz", seed=1, progress=False, device="cpu")
     script = (
         "import sys, torch, metainterface as mi\n"
-        "from metainterface.surrogate.train import TrainConfig\n"
+        "from metainterface.surrogate.config import TrainConfig\n"
         "torch.use_deterministic_algorithms(True)\n"
         "cfg = TrainConfig(epochs=2, batch_size=64, physics_steps=32)\n"
         "r = mi.train_surrogate(sys.argv[1], sys.argv[2], cfg, progress=False, device='cuda')\n"

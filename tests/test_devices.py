@@ -22,11 +22,12 @@ from metainterface.data import generate_dataset, load_dataset
 from metainterface.inverse.refine import RefineSettings
 from metainterface.physics.curves import curve
 from metainterface.surrogate.checkpoint import load_model, load_torch
+from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.loss import param_loss, physics_loss
 from metainterface.surrogate.model import InverseMLP
 from metainterface.surrogate.schedules import Schedules
-from metainterface.surrogate.train import TrainConfig, read_metrics, train
+from metainterface.surrogate.train import read_metrics, train
 
 S = mi.CellSettings()
 NO_CUDA = not torch.cuda.is_available()

@@ -118,7 +118,7 @@ _HOMES: dict[str, str] = {
     "register_model": "metainterface.physics.models",
     "tune_allocator": "metainterface.runtime",
     "set_threads": "metainterface._threads",
-    "TrainConfig": "metainterface.surrogate.train",
+    "TrainConfig": "metainterface.surrogate.config",
     "ValidationResult": "metainterface.validation.result",
     "FeasibleScale": "metainterface.scaling.search",
     "BemCheck": "metainterface.verify.check",
@@ -156,7 +156,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.scaling.choose import design_scale, feasible_scale
     from metainterface.scaling.search import FeasibleScale
     from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
-    from metainterface.surrogate.train import TrainConfig
+    from metainterface.surrogate.config import TrainConfig
     from metainterface.sweep.many import validate_many
     from metainterface.sweep.validate import validate, write_result
     from metainterface.units.reach import Reachability

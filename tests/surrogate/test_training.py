@@ -11,11 +11,12 @@ from metainterface.data import generate_dataset, load_dataset
 from metainterface.errors import MetainterfaceError
 from metainterface.physics import CellSettings
 from metainterface.surrogate.checkpoint import load_model
+from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.loss import LossWeights, weights_of
 from metainterface.surrogate.model import Dropout, InverseMLP, outputs_to_design
 from metainterface.surrogate.schedules import Schedules
-from metainterface.surrogate.train import TrainConfig, read_metrics, train
+from metainterface.surrogate.train import read_metrics, train
 
 S = CellSettings()
 

@@ -18,10 +18,11 @@ from metainterface.plots import plot_reconstructions, plot_training
 from metainterface.reproduce.context import Context, model_label, pct
 from metainterface.reproduce.figures import plot_regularisation, plot_wall_case
 from metainterface.surrogate.checkpoint import load_model
+from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.evaluate import Predictions, evaluate, predict_split
 from metainterface.surrogate.loss import weights_of
-from metainterface.surrogate.train import TrainConfig, read_metrics, train
+from metainterface.surrogate.train import read_metrics, train
 
 # -- the dataset, fig. 3 and the wall case --------------------------------------------------
 

@@ -19,11 +19,12 @@ from metainterface.data import load_dataset
 from metainterface.data.dataset import DEFAULT_CHUNK, GenerationReport
 from metainterface.physics.cell import CellSettings
 from metainterface.surrogate.checkpoint import default_model_path, load_model
+from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.evaluate import evaluate
 from metainterface.surrogate.laws import law_split
 from metainterface.surrogate.loss import weights_of
-from metainterface.surrogate.train import TrainConfig, TrainResult, train
+from metainterface.surrogate.train import TrainResult, train
 
 #: Seeds of the friction-law-like targets a laws network is evaluated on (train, test):
 #: fixed, and apart from training's (its seed and seed + 1).
