@@ -114,7 +114,7 @@ def test_cuda_training_is_bitwise_repeatable_with_deterministic_algorithms(tmp_p
 @pytest.mark.parametrize("method", ["surrogate", "multistart"])
 def test_design_on_cuda_matches_cpu(method):
     names = ["saturating", "bilinear", "linear"]
-    options = dict(method=method, starts=4, hedge=2, refine_settings=QUICK)
+    options = dict(method=method, effort=mi.Effort(starts=4, hedge=2, refine_settings=QUICK))
     cpu = mi.design(names, device="cpu", **options)
     gpu = mi.design(names, device="cuda", **options)
     for a, b in zip(cpu, gpu, strict=True):

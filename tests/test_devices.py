@@ -131,7 +131,9 @@ def _same_designs(a, b):
 @pytest.mark.parametrize("method", ["surrogate", "multistart", "hertz"])
 def test_design_many_targets_on_cpu_and_auto(method):
     names = ["saturating", "bilinear", "linear"]
-    options = dict(method=method, starts=3, hedge=2, fallback=0, refine_settings=QUICK)
+    options = dict(
+        method=method, effort=mi.Effort(starts=3, hedge=2, fallback=0, refine_settings=QUICK)
+    )
     runs = [mi.design(names, device=d, **options) for d in DEVICES]
     for r in runs:
         assert [x.target.name for x in r] == names
@@ -146,11 +148,8 @@ def test_design_many_targets_on_cpu_and_auto(method):
 def test_robust_printable_design_on_cpu_and_auto():
     options = dict(
         method="multistart",
-        starts=2,
-        refine_settings=QUICK,
-        robust=True,
-        sigma_h=0.001,
-        robust_samples=4,
+        effort=mi.Effort(starts=2, refine_settings=QUICK),
+        robust=mi.Robust(sigma_h=0.001, samples=4),
         z_step=0.001,
     )
     runs = [mi.design("saturating", device=d, **options) for d in DEVICES]

@@ -77,7 +77,7 @@ except PackageNotFoundError:  # running from a source tree that was not installe
 #: command line's ``--help`` answers without torch); a name's module is imported on first use
 #: (PEP 562), and ``dir(mi)``, ``help(mi)`` and the API reference still list every name.
 _HOMES: dict[str, str] = {
-    "Curve": "metainterface.designer.curves",
+    "Curve": "metainterface.designer.curve_result",
     "DesignResult": "metainterface.designer.results",
     "PrinterSizing": "metainterface.manufacture.sizing",
     "ToleranceResult": "metainterface.manufacture.tolerance",
@@ -92,10 +92,10 @@ _HOMES: dict[str, str] = {
     "pressure_check": "metainterface.designer.given",
     "tolerance": "metainterface.manufacture.tolerance",
     "train_surrogate": "metainterface.surrogate.build",
-    "validate": "metainterface.sweep.validate",
+    "validate": "metainterface.sweep.folders",
     "validate_many": "metainterface.sweep.many",
     "view": "metainterface.designer.view",
-    "write_result": "metainterface.sweep.validate",
+    "write_result": "metainterface.sweep.folders",
     "design_scale": "metainterface.scaling.choose",
     "Effort": "metainterface.designer.options",
     "Robust": "metainterface.designer.options",
@@ -106,7 +106,7 @@ _HOMES: dict[str, str] = {
     "UnitSlipWarning": "metainterface.errors",
     "ReachWarning": "metainterface.errors",
     "Reachability": "metainterface.units.reach",
-    "reachability": "metainterface.inverse.reach",
+    "reachability": "metainterface.inverse.verdict",
     "Target": "metainterface.inverse.targets",
     "CellSettings": "metainterface.physics.cell",
     "Design": "metainterface.physics.cell",
@@ -127,7 +127,7 @@ _HOMES: dict[str, str] = {
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface._threads import set_threads
-    from metainterface.designer.curves import Curve
+    from metainterface.designer.curve_result import Curve
     from metainterface.designer.given import curve, export, physical, pressure_check
     from metainterface.designer.options import Effort, Robust, Scale
     from metainterface.designer.results import DesignResult
@@ -139,8 +139,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         UnitSlipWarning,
         UnreachableError,
     )
-    from metainterface.inverse.reach import reachability
     from metainterface.inverse.targets import Target
+    from metainterface.inverse.verdict import reachability
     from metainterface.manufacture.sizing import PrinterSizing, min_radius
     from metainterface.manufacture.tolerance import ToleranceResult, tolerance
     from metainterface.physics.cell import CellSettings, Design
@@ -157,8 +157,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.scaling.search import FeasibleScale
     from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
     from metainterface.surrogate.config import TrainConfig
+    from metainterface.sweep.folders import validate, write_result
     from metainterface.sweep.many import validate_many
-    from metainterface.sweep.validate import validate, write_result
     from metainterface.units.reach import Reachability
     from metainterface.validation.result import ValidationResult
     from metainterface.verify.check import BemCheck, Verify

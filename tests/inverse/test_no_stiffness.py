@@ -33,7 +33,7 @@ def test_constant_training_inputs_are_set_to_their_constant():
 def test_cell_curves_without_stiffness_read_like_with_it():
     cells = _cells()
     bare = [mi.Target(p_star=t.p_star, alpha=t.alpha, name=t.name) for t in cells]
-    opts = dict(refine=False, hedge=0, fallback=0, verify=False)
+    opts = dict(effort=mi.Effort(refine=False, hedge=0, fallback=0), verify=False)
     with_s = np.array([r.error for r in mi.design(cells, **opts)])
     without = np.array([r.error for r in mi.design(bare, **opts)])
     # the same network on the same curves: a few % at most either way (before the constant

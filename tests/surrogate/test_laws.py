@@ -137,11 +137,15 @@ def test_design_reads_friction_laws_with_the_law_network(tmp_path):
     targets = _law_targets()
     alone = tmp_path / "surrogate.pt"  # the shipped surrogate under another name: no laws net
     shutil.copy(default_model_path(), alone)
-    quick = dict(refine=False, hedge=0, fallback=0, verify=False)
+    quick = dict(refine=False, hedge=0, fallback=0)
+    verify = False
     before = np.array(
-        [r.error for r in mi.design(targets, **quick, effort=mi.Effort(surrogate=alone))]
+        [
+            r.error
+            for r in mi.design(targets, verify=verify, effort=mi.Effort(surrogate=alone, **quick))
+        ]
     )
-    made = mi.design(targets, **quick)
+    made = mi.design(targets, verify=verify, effort=mi.Effort(**quick))
     after = np.array([r.error for r in made])
     assert any(r.zero_shot_from.startswith("friction-law network") for r in made)
     assert all(r.record()["zero_shot_from"] == r.zero_shot_from for r in made)
@@ -151,12 +155,14 @@ def test_design_reads_friction_laws_with_the_law_network(tmp_path):
     with_s = mi.Target(
         p_star=targets[0].p_star, alpha=targets[0].alpha, stiffness=np.ones_like(targets[0].p_star)
     )
-    a = mi.design(with_s, **quick, effort=mi.Effort(surrogate=alone))
-    b = mi.design(with_s, **quick)
+    a = mi.design(with_s, verify=verify, effort=mi.Effort(surrogate=alone, **quick))
+    b = mi.design(with_s, verify=verify, effort=mi.Effort(**quick))
     np.testing.assert_array_equal(a.design.gamma, b.design.gamma)
     assert b.zero_shot_from == "surrogate"
     assert (
-        mi.design(with_s, method="multistart", **quick, effort=mi.Effort(starts=2)).zero_shot_from
+        mi.design(
+            with_s, method="multistart", verify=verify, effort=mi.Effort(starts=2, **quick)
+        ).zero_shot_from
         == ""
     )
 

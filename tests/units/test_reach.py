@@ -111,9 +111,10 @@ def test_design_refuses_an_unreachable_law_in_one_line(tmp_path):
 
 def test_forced_design_is_marked_everywhere(tmp_path):
     t = mi.Target.from_friction(_csv(tmp_path, "c", LAWS["constant"]), **UNITS)
-    r = mi.design(
-        t, force=True, out=tmp_path / "f", verify=False, effort=mi.Effort(hedge=0, fallback=0)
-    )
+    with pytest.warns(mi.ReachWarning, match=r"friction law c: not reachable.*closest cell$"):
+        r = mi.design(
+            t, force=True, out=tmp_path / "f", verify=False, effort=mi.Effort(hedge=0, fallback=0)
+        )
     assert r.forced and "FORCED" in repr(r) and r.notes[0].startswith("FORCED")
     assert r.coverage < 0.5 and r.error >= 1 - r.coverage
     record = json.loads((tmp_path / "f" / "design.json").read_text())

@@ -4,7 +4,7 @@ compare, curve, export, physical, pressure_check, view, DesignResult, Curve),
 ``manufacture`` (tolerance, min_radius), ``sweep`` (validate, validate_many, write_result)
 and ``surrogate.build`` (generate_dataset, train_surrogate, evaluate_surrogate)."""
 
-from metainterface.designer.curves import Curve
+from metainterface.designer.curve_result import Curve
 from metainterface.designer.given import curve, export, physical, pressure_check
 from metainterface.designer.results import DesignResult
 from metainterface.designer.run import compare, design
@@ -12,8 +12,8 @@ from metainterface.designer.view import view
 from metainterface.manufacture.sizing import PrinterSizing, min_radius
 from metainterface.manufacture.tolerance import ToleranceResult, tolerance
 from metainterface.surrogate.build import evaluate_surrogate, generate_dataset, train_surrogate
+from metainterface.sweep.folders import validate, write_result
 from metainterface.sweep.many import validate_many
-from metainterface.sweep.validate import validate, write_result
 
 __all__ = [
     "Curve",

@@ -15,7 +15,7 @@ from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_file
 from metainterface._threads import uses_threads
-from metainterface.designer.curves import CURVE_STEPS, Curve, design_curve, idle_notes
+from metainterface.designer.curve_result import CURVE_STEPS, Curve, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.limits import PressureCheck, check_pressure

@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-from metainterface.designer.curves import (
+from metainterface.designer.curve_result import (
     CURVE_STEPS,
     Curve,
     ReachCounts,

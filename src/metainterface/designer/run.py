@@ -16,7 +16,7 @@ from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
 from metainterface._files.provenance import current_command
 from metainterface._threads import uses_threads
-from metainterface.designer.curves import reach_note
+from metainterface.designer.curve_result import reach_note
 from metainterface.designer.given import _limit, _physical_options
 from metainterface.designer.options import (
     OLD_KEYWORDS,
@@ -32,9 +32,9 @@ from metainterface.errors import MetainterfaceError, ReachWarning
 from metainterface.inverse import pipeline
 from metainterface.inverse.envelope import reachability_warnings
 from metainterface.inverse.perturb import Perturbation
-from metainterface.inverse.reach import refuse_unreachable
 from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
+from metainterface.inverse.verdict import refuse_unreachable
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.limits import PressureCheck, check_pressure, pressure_penalty
 from metainterface.physics.models import ForwardModel, get_model
@@ -309,7 +309,9 @@ def _say_reach(items: list[Target], settings: CellSettings, reach: dict[str, Any
             lines = [f"friction law {t.name}: " + reach[t.name].message.replace("\n", " ")]
         if lines:
             warnings.warn(
-                "; ".join(lines) + "; designing the closest cell", ReachWarning, stacklevel=4
+                "; ".join(line.rstrip(". ") for line in lines) + "; designing the closest cell",
+                ReachWarning,
+                stacklevel=4,
             )
 
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from metainterface._files import strict_json
 from metainterface._files.atomic import write_text
-from metainterface.designer.curves import design_curve
+from metainterface.designer.curve_result import design_curve
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from metainterface.designer.curves import design_curve
+from metainterface.designer.curve_result import design_curve
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import METHODS, builtin_target, design
 from metainterface.physics.cell import Design

@@ -32,7 +32,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, require_xarray
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, get_model
-from metainterface.sweep.validate import request_hash, write_result
+from metainterface.sweep.folders import request_hash, write_result
 from metainterface.validation.batched import solve_batched
 from metainterface.validation.bem import (
     MAX_ITER,
