@@ -27,6 +27,7 @@ RANKS = {
     "designer": 5,
     "sweep": 5,
     "manufacture": 6,
+    "measure": 6,
     "api": 7,
     "__init__": 7,  # the lazy face, ``import metainterface as mi``
     "reproduce": 7,
