@@ -38,6 +38,10 @@ Checking and making
     write_result, export
 Looking at a design
     view (an interactive, self-contained HTML page; the [view] extra), DesignResult.figure
+The part as made
+    measure (a scan of the made part in: registered to its design, every asperity fitted,
+    its law predicted by BEM; the [measure] extra reads the scan), MeasureResult
+    (.compensate(): the geometry to print next so that the made part meets the target)
 Manufacturing errors
     tolerance, ToleranceResult (the band of alpha(P*) and the error under height, shape and
     scale errors), min_radius, PrinterSizing (the smallest R for a printer's height error);
@@ -121,6 +125,8 @@ _HOMES: dict[str, str] = {
     "FeasibleScale": "metainterface.inverse.scale",
     "BemCheck": "metainterface.verify.check",
     "Verify": "metainterface.verify.check",
+    "measure": "metainterface.measure.run",
+    "MeasureResult": "metainterface.measure.result",
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
@@ -138,6 +144,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.inverse.targets import Target
     from metainterface.manufacture.sizing import PrinterSizing, min_radius
     from metainterface.manufacture.tolerance import ToleranceResult, tolerance
+    from metainterface.measure.result import MeasureResult
+    from metainterface.measure.run import measure
     from metainterface.physical.reach import Reachability
     from metainterface.physics.cell import CellSettings, Design
     from metainterface.physics.models import (
@@ -201,6 +209,7 @@ __all__ = [
     "ForwardModel",
     "Independent",
     "Interacting",
+    "MeasureResult",
     "MetainterfaceError",
     "PrinterSizing",
     "Reachability",
@@ -223,6 +232,7 @@ __all__ = [
     "feasible_scale",
     "generate_dataset",
     "get_model",
+    "measure",
     "min_radius",
     "physical",
     "pressure_check",
