@@ -89,7 +89,7 @@ def test_compensated_design_made_with_the_same_errors_meets_the_target(design, m
 
 def test_files(design, measured, tmp_path):
     comp = measured.compensate()
-    measured.write(tmp_path, compensated=comp)
+    measured.write(tmp_path, compensate=comp)
     summary = json.loads((tmp_path / "measured.json").read_text())
     assert summary["asperities_fitted"] == 81
     assert summary["lattice"]["rotation_deg"] == pytest.approx(2.0, abs=0.05)

@@ -6,7 +6,7 @@ import csv
 import io
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -46,7 +46,8 @@ class Friction:
 class MeasureResult:
     """A made part measured: ``registration`` (lattice, tilt, fitted asperities),
     ``prediction`` (BEM and fitted-model curves, errors to the target), the scan and the
-    design; ``friction`` where a modulus, shear strength and area were given.
+    design; ``friction`` where a modulus, shear strength and area were given;
+    ``compensation`` where ``measure(..., compensate=True)`` made it.
 
     Lengths in the result's tables are in micrometres at the scan's R.
     """
@@ -56,7 +57,7 @@ class MeasureResult:
     registration: Registration
     prediction: Prediction
     friction: Friction | None = None
-    _extra: dict[str, Any] = field(default_factory=dict, repr=False)
+    compensation: Compensation | None = None
 
     @property
     def error(self) -> float:
@@ -77,7 +78,16 @@ class MeasureResult:
             f"MeasureResult({int(r.seen.sum())} asperities fitted in {self.scan.source}, "
             f"rotation {math.degrees(r.lattice.theta):.3g} deg; made error "
             f"{100 * p.error_bem:.3g} % (BEM), {100 * p.error_fit:.3g} % (fitted model); "
-            f"design {100 * p.error_design:.3g} %)"
+            f"design {100 * p.error_design:.3g} %{self._compensated()})"
+        )
+
+    def _compensated(self) -> str:
+        c = self.compensation
+        if c is None:
+            return ""
+        return (
+            f"; compensated print: made error {100 * c.error_before:.3g} % -> "
+            f"{100 * c.error_after:.3g} % (predicted)"
         )
 
     def compensate(self, *others: MeasureResult, model: Any = None) -> Compensation:
@@ -180,14 +190,25 @@ class MeasureResult:
         return buf.getvalue()
 
     def write(
-        self, folder: str | os.PathLike[str], *, compensated: Compensation | None = None
+        self,
+        folder: str | os.PathLike[str],
+        *,
+        compensate: bool | Compensation | None = None,
     ) -> list[Path]:
-        """measured.json, bem.csv, measured.png (and compensated.json) in ``folder``,
-        each written atomically."""
+        """measured.json, bem.csv, measured.png in ``folder``, each written atomically; and
+        compensated.json (a design file: the geometry to print next) with ``compensate``
+        (True: ``self.compensate()``; or a Compensation already made; None: this result's
+        ``compensation`` if it has one). Returns the paths."""
         from metainterface._files import strict_json
-        from metainterface._files.atomic import atomic_path, write_text
+        from metainterface._files.atomic import atomic_path, check_output_folder, write_text
 
-        folder = Path(folder)
+        if compensate is None:
+            compensated = self.compensation
+        elif compensate is True:
+            compensated = self.compensate()
+        else:
+            compensated = compensate or None
+        folder = check_output_folder(folder)
         folder.mkdir(parents=True, exist_ok=True)
         out = [
             write_text(
@@ -202,7 +223,7 @@ class MeasureResult:
 
         plt.close(fig)
         out.append(folder / "measured.png")
-        if compensated is not None:
+        if isinstance(compensated, Compensation):
             out.append(compensated.printed.save(folder / "compensated.json"))
         return out
 

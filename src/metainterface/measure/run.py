@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 from typing import Any
 
@@ -29,6 +30,8 @@ def measure(
     loads: int = 8,
     model: Any = None,
     progress: bool = True,
+    compensate: bool = False,
+    out: str | os.PathLike[str] | None = None,
 ) -> MeasureResult:
     """Measure a made part: read, level and register its scan, fit every asperity of every
     cell, and predict its friction law (BEM on the measured cell, and the forward model with
@@ -42,6 +45,9 @@ def measure(
     shear_strength, area: E* [Pa], tau [Pa], nominal area [m^2] (all three or none), for
     friction in newtons. grid: the measured cell's BEM grid (default: the scan's own
     resolution, 64 n to 256 n). loads: BEM loads. progress: a bar over the BEM loads.
+    compensate: also design the next print (``MeasureResult.compensation``; the same as
+    ``.compensate()`` later). out: a folder to write measured.json, bem.csv, measured.png
+    (and compensated.json) in (``MeasureResult.write``).
 
     Returns a :class:`MeasureResult` (``.registration``, ``.prediction``, ``.error``,
     ``.compensate()``, ``.write(folder)``). Raises MetainterfaceError in one line: unknown
@@ -61,6 +67,10 @@ def measure(
     friction = _friction(modulus, shear_strength, area)
     if isinstance(loads, bool) or not isinstance(loads, int) or not 2 <= loads <= 200:
         raise MetainterfaceError(f"loads must be a whole number in [2, 200], got {loads!r}")
+    if out is not None:
+        from metainterface._files.atomic import check_output_folder
+
+        check_output_folder(out)  # before the work, not after
     if grid is not None:
         from metainterface.validation import check_grid
 
@@ -74,9 +84,14 @@ def measure(
             bar = stack.enter_context(tqdm(total=loads, desc="BEM loads", unit="load"))
             report = bar.update
         pred = predict(s, reg, design, grid=grid, loads=loads, model=model, report=report)
-    return MeasureResult(
+    result = MeasureResult(
         scan=s, design=design, registration=reg, prediction=pred, friction=friction
     )
+    if compensate:
+        result = dataclasses.replace(result, compensation=result.compensate(model=model))
+    if out is not None:
+        result.write(out)
+    return result
 
 
 def _friction(modulus: Any, shear_strength: Any, area: Any) -> Friction | None:
