@@ -39,9 +39,10 @@ Checking and making
 Looking at a design
     view (an interactive, self-contained HTML page; the [view] extra), DesignResult.figure
 The part as made
-    measure (a scan of the made part in: registered to its design, every asperity fitted,
-    its law predicted by BEM; the [measure] extra reads the scan), MeasureResult
-    (.compensate(): the geometry to print next so that the made part meets the target)
+    measure, MeasureResult
+    (a scan of the made part in, registered to its design, every asperity fitted, its law
+    predicted by BEM; .compensate(): the geometry to print next so that the made part
+    meets the target; the [measure] extra reads the scan)
 Manufacturing errors
     tolerance, ToleranceResult (the band of alpha(P*) and the error under height, shape and
     scale errors), min_radius, PrinterSizing (the smallest R for a printer's height error);
