@@ -123,3 +123,19 @@ def test_friction_needs_all_three(design):
     z, dx = scan_of(design, MADE, cells=1.2, points=100)
     with pytest.raises(mi.MetainterfaceError, match="modulus, shear_strength and area"):
         mi.measure(z * R, design, radius="0.5mm", pixel_size=dx * R, modulus="2MPa")
+
+
+def test_compensated_design_exports_as_any_other(measured, tmp_path):
+    comp = measured.compensate()
+    mi.export(comp.printed, tmp_path / "next.npy", radius="0.5mm")
+    assert np.isfinite(np.load(tmp_path / "next.npy")).all()
+
+
+def test_map_from_two_scans(design, measured):
+    # a second part of the same print, scanned elsewhere on the plate, less well
+    z, dx = scan_of(design, MADE, cells=2, points=180, theta_deg=-1.0, noise=4e-4, seed=3)
+    other = mi.measure(z * R, design, radius="0.5mm", pixel_size=dx * R, progress=False)
+    comp = measured.compensate(other)
+    assert comp.pmap.gamma_shift == pytest.approx(0.15, abs=0.01)
+    assert comp.pmap.h_scale == pytest.approx(0.85, abs=0.02)
+    assert comp.error_after < 0.01

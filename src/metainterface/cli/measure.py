@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 
 from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
+from metainterface.cli.common import add_device
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -57,6 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="forward model (default: the paper's independent asperities)",
     )
     p.add_argument("--out", required=True, help="output folder")
+    add_device(p)
     p.set_defaults(func=run)
 
 
@@ -80,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
         model=args.model,
         out=args.out,
         compensate=args.compensate,
+        device=args.device,
     )
     print(repr(result))
     return 0

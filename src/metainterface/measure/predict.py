@@ -183,8 +183,13 @@ def predict(
     model: Any = None,
     report: Callable[[int], Any] | None = None,
     engine: Any = None,
+    device: Any = "auto",
 ) -> Prediction:
-    """BEM of the measured cell and the fitted model, against the design's target."""
+    """BEM of the measured cell and the fitted model, against the design's target.
+
+    grid: M of the measured cell (default ``default_grid``); loads: K BEM loads, uniform up
+    to the made part's P*_max (or the target's largest load); model: the forward model;
+    report: called with 1 after each load; engine, device: the BEM's (``solve_path``)."""
     s = design.settings
     target = target_of(design, model)
     grid = default_grid(scan, design) if grid is None else grid
@@ -200,6 +205,7 @@ def predict(
         owner_map(s.n_side, grid),
         s.n_asperities,
         engine=engine,
+        device=device,
         threads=None,
         report=report,
     )

@@ -251,6 +251,7 @@ class MeasureResult:
             target=p.target,
             error_bem=p.error_bem,
             error_design=p.error_design,
+            to_forces=None if self.friction is None else self.friction.forces,
         )
 
 

@@ -32,6 +32,7 @@ def measure(
     progress: bool = True,
     compensate: bool = False,
     out: str | os.PathLike[str] | None = None,
+    device: Any = "auto",
 ) -> MeasureResult:
     """Measure a made part: read, level and register its scan, fit every asperity of every
     cell, and predict its friction law (BEM on the measured cell, and the forward model with
@@ -47,7 +48,8 @@ def measure(
     resolution, 64 n to 256 n). loads: BEM loads. progress: a bar over the BEM loads.
     compensate: also design the next print (``MeasureResult.compensation``; the same as
     ``.compensate()`` later). out: a folder to write measured.json, bem.csv, measured.png
-    (and compensated.json) in (``MeasureResult.write``).
+    (and compensated.json) in (``MeasureResult.write``). device: where the BEM runs
+    ("auto", "cpu", "cuda", "cuda:N").
 
     Returns a :class:`MeasureResult` (``.registration``, ``.prediction``, ``.error``,
     ``.compensate()``, ``.write(folder)``). Raises MetainterfaceError in one line: unknown
@@ -83,7 +85,9 @@ def measure(
 
             bar = stack.enter_context(tqdm(total=loads, desc="BEM loads", unit="load"))
             report = bar.update
-        pred = predict(s, reg, design, grid=grid, loads=loads, model=model, report=report)
+        pred = predict(
+            s, reg, design, grid=grid, loads=loads, model=model, report=report, device=device
+        )
     result = MeasureResult(
         scan=s, design=design, registration=reg, prediction=pred, friction=friction
     )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -17,9 +19,12 @@ def measure_figure(
     target: tuple[np.ndarray, np.ndarray],
     error_bem: float,
     error_design: float,
+    to_forces: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
 ) -> Figure:
     """Four panels. scan, designed: (ny, nx) levelled heights [um] on the scan's grid;
-    extent: (x0, x1, y0, y1) [um]; p_star, alpha_bem, alpha_fit: (K,); target: (p, alpha)."""
+    extent: (x0, x1, y0, y1) [um]; p_star, alpha_bem, alpha_fit: (K,); target: (p, alpha).
+    to_forces: (p_star, alpha) -> (normal force, friction) [N]; with it the law is drawn
+    as friction against normal force."""
     fig = Figure(figsize=(13, 3.6), layout="constrained")
     axes = fig.subplots(1, 4)
     lo, hi = np.nanpercentile(designed, [1, 100])
@@ -38,11 +43,19 @@ def measure_figure(
     axes[2].set_xlabel("x [um]")
     fig.colorbar(im, ax=axes[2], shrink=0.8)
     ax = axes[3]
-    ax.plot(target[0], target[1], "k-", lw=1.5, label=f"target (design {100 * error_design:.2g} %)")
-    ax.plot(p_star, alpha_bem, "o-", color="C3", label=f"made, BEM ({100 * error_bem:.2g} %)")
-    ax.plot(p_star, alpha_fit, "s--", color="C0", ms=4, label="made, fitted model")
-    ax.set_xlabel("P* = P / E*")
-    ax.set_ylabel("alpha = A_real / A_nom")
+
+    def law(p: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return (p, a) if to_forces is None else to_forces(p, a)
+
+    ax.plot(*law(*target), "k-", lw=1.5, label=f"target (design {100 * error_design:.2g} %)")
+    ax.plot(*law(p_star, alpha_bem), "o-", color="C3", label=f"made, BEM ({100 * error_bem:.2g} %)")
+    ax.plot(*law(p_star, alpha_fit), "s--", color="C0", ms=4, label="made, fitted model")
+    if to_forces is None:
+        ax.set_xlabel("P* = P / E*")
+        ax.set_ylabel("alpha = A_real / A_nom")
+    else:
+        ax.set_xlabel("normal force [N]")
+        ax.set_ylabel("friction force [N]")
     ax.set_title("predicted law")
     ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 2))
     ax.legend(fontsize=8)
