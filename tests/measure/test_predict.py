@@ -98,6 +98,11 @@ def test_files(design, measured, tmp_path):
     h_design = np.array([r["h_design_um"] for r in rows])
     dev = np.array([r["h_deviation_um"] for r in rows])
     np.testing.assert_allclose(dev, -0.15 * (h_design - h_design.mean()), atol=0.1)
+    cells = summary["cells"]
+    assert len(cells) == 81
+    for row in rows:  # each asperity's made height is the mean over its cells
+        mine = [c["h_um"] for c in cells if c["k"] == row["k"]]
+        assert np.mean(mine) == pytest.approx(row["h_made_um"], abs=1e-6)
     header = (tmp_path / "bem.csv").read_text().splitlines()[0].split(",")
     assert header[:2] == ["p_star", "alpha_bem"] and "friction_N" in header
     table = np.loadtxt(tmp_path / "bem.csv", delimiter=",", skiprows=1)

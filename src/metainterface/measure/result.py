@@ -127,6 +127,30 @@ class MeasureResult:
             )
         return rows
 
+    def instances(self) -> list[dict[str, Any]]:
+        """Every fitted asperity of every cell: its cell (column, row), index k, exponent,
+        tip height (plane removed, aligned as ``h``) and lateral shift in um, fit residual."""
+        r, um = self.registration, 1e6 * self.scan.radius_m
+        f = r.fits
+        d = self.design
+        # the alignment of register: made h = -z0 - offset, the mean over asperities kept
+        offset = np.mean(
+            -np.bincount(f.kind, f.z0, d.n_asperities)[r.seen > 0] / r.seen[r.seen > 0]
+        ) - np.mean(r.h[r.seen > 0])
+        return [
+            {
+                "cell": [int(f.cell[i, 0]), int(f.cell[i, 1])],
+                "k": int(f.kind[i]),
+                "gamma": float(f.gamma[i]),
+                "h_um": float((-f.z0[i] - offset) * um),
+                "shift_x_um": float(f.shift[i, 0] * um),
+                "shift_y_um": float(f.shift[i, 1] * um),
+                "rms_um": float(f.rms[i] * um),
+                "covered": float(min(1.0, f.cover[i])),
+            }
+            for i in range(f.kind.size)
+        ]
+
     def summary(self) -> dict[str, Any]:
         r, p = self.registration, self.prediction
         um = 1e6 * self.scan.radius_m
@@ -155,6 +179,7 @@ class MeasureResult:
             "bem_filled_share": p.cell.filled,
             "disagree_p_star": [float(v) for v in p.p_star[p.disagree]],
             "asperities": self.asperities(),
+            "cells": self.instances(),
             "fitted_map": {
                 "gamma": [float(v) for v in r.gamma],
                 "h": [float(v) for v in r.h],
