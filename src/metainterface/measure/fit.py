@@ -145,14 +145,14 @@ def fit_lattice(
         k = torch.exp(-ls)
         return k * (c * dx + sn * dy), k * (-sn * dx + c * dy)  # in design pitches
 
+    rms = math.nan
     for _ in range(rounds):
         with torch.no_grad():  # which asperity and which points, fixed for the round
             u, v = local(o, th, ls)
             col, row = torch.floor(u), torch.floor(v)
             kind = (torch.remainder(row, n) * n + torch.remainder(col, n)).long()
             r = torch.hypot(u - col - 0.5, v - row - 0.5)
-            keep = r < 0.5
-            # pin z's mean so the tip heights' common offset is not free twice
+            keep = r < 0.5  # the disc inscribed in the asperity's square
         xs, ys, zk, kk = x[keep], y[keep], z[keep], kind[keep]
         cols, rows = col[keep], row[keep]
         if zk.numel() == 0:

@@ -152,7 +152,7 @@ class Prediction:
     p_star: (K,) BEM loads; alpha_bem, alpha_fit, alpha_design: (K,) the BEM on the measured
     cell, the forward model with the fitted asperities, the design's model. error_bem,
     error_fit, error_design, coverage_*: curve errors to the target (and coverage).
-    disagree: (K,) bool, where |alpha_bem / alpha_fit - 1| > DISAGREE. cell: the measured
+    disagree: (K,) bool, where abs(alpha_bem / alpha_fit - 1) > DISAGREE. cell: the measured
     cell solved. share: (N,) each asperity's share of the made curve error (the error of
     the design with that asperity alone made as measured, normalised over the asperities).
     error_alone: (N,) those errors.
