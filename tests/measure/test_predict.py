@@ -144,3 +144,19 @@ def test_map_from_two_scans(design, measured):
     assert comp.pmap.gamma_shift == pytest.approx(0.15, abs=0.01)
     assert comp.pmap.h_scale == pytest.approx(0.85, abs=0.02)
     assert comp.error_after < 0.01
+
+
+def test_a_shape_the_family_cannot_describe_is_reported(design):
+    # tips flattened to caps of radius 20 R over half of a_max: no power law fits them, so
+    # the BEM on the measured cell and the fitted model part, and the result says where
+    made = Made(tip_rho=20.0, tip_r0=0.5 * design.settings.a_max)
+    z, dx = scan_of(design, made, cells=1.2, points=160)
+    res = mi.measure(z * R, design, radius="0.5mm", pixel_size=dx * R, progress=False, loads=3)
+    np.testing.assert_allclose(res.registration.tip_radius, 20.0, rtol=0.03)
+    assert res.prediction.disagree.all()
+    assert "not all power laws" in res.summary()["disagreement"]
+    # the same scan without the caps: the two agree
+    z, dx = scan_of(design, Made(), cells=1.2, points=160)
+    res = mi.measure(z * R, design, radius="0.5mm", pixel_size=dx * R, progress=False, loads=3)
+    assert not res.prediction.disagree.any()
+    assert "disagreement" not in res.summary()
