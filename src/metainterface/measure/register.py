@@ -19,6 +19,9 @@ from metainterface.measure.lattice import Lattice, first_lattice
 from metainterface.measure.scan import Scan
 from metainterface.physics.cell import Design
 
+#: Rounds of the lattice fit for scans that show each asperity once (``fit.fit_lattice``).
+TIED_ROUNDS = 8
+
 
 @dataclass(frozen=True)
 class Registration:
@@ -68,7 +71,12 @@ def register(scan: Scan, design: Design) -> Registration:
     n = design.n_asperities
     if fits.kind.size:
         z0, gamma, _ = _by_kind(fits, n, design)
-        refined = fit_lattice(scan, design, lattice, tilt, z0, gamma, tied=not _repeated(fits))
+        tied = not _repeated(fits)
+        # a scan of part of a cell levels slowly (tilt, shapes and heights trade off over few
+        # asperities); it is small, so more rounds cost little
+        refined = fit_lattice(
+            scan, design, lattice, tilt, z0, gamma, tied=tied, rounds=TIED_ROUNDS if tied else 2
+        )
         lattice, tilt = refined.lattice, refined.tilt
         fits = fit_asperities(scan, design, lattice, tilt)
     if fits.kind.size == 0:
