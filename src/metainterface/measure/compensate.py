@@ -5,7 +5,8 @@ more (design, registration) pairs, and the geometry to send to the printer so th
 The map (``PrintMap``): gamma_made = gamma + shift + bias_gamma_k, and
 h_made = scale h + bias_h_k (h anchored, min 0; the made heights aligned on the design's
 mean, ``register``), the per-asperity biases the mean residuals at lattice index k (kept
-only when every pair has that asperity count). The printed geometry starts from the map's
+only when every pair has N asperities, all seen; else none, the height bias a common
+offset). The printed geometry starts from the map's
 inverse applied to the design (the made part would then be the design), clipped to the
 printer's bounds (the design's gamma bounds, h >= 0), and is refined with the map inside:
 the forward model's curve of map(printed) is fitted to the target.
