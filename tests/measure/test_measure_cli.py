@@ -21,7 +21,7 @@ def files(tmp_path_factory):
     folder = tmp_path_factory.mktemp("measure")
     design = example()
     design.save(folder / "design.json")
-    z, dx = scan_of(design, Made(gamma_shift=0.1, h_scale=0.9), cells=1.5, points=150)
+    z, dx = scan_of(design, Made(gamma_shift=0.1, h_scale=0.9), cells=2.2, points=160)
     np.save(folder / "scan.npy", (z * R * 1e6).T)  # SurfaceTopography's [x, y] order
     return folder, z.shape[1] * dx * R
 
@@ -80,3 +80,28 @@ def test_unknown_format(files, capsys, tmp_path):
     ]  # fmt: skip
     assert main(argv) == 2
     assert "unknown scan format" in capsys.readouterr().err
+
+
+def test_also_joins_more_scans_to_the_map(files, tmp_path):
+    folder, width = files
+    scan = str(folder / "scan.npy")
+    argv = [
+        "measure", scan, "--design", str(folder / "design.json"), "--radius", "0.5mm",
+        "--size", f"{width * 1e3}mm", "--height-unit", "um", "--loads", "2", "--compensate",
+        "--also", scan, str(folder / "design.json"), "--out", str(tmp_path / "out"),
+    ]  # fmt: skip
+    assert main(argv) == 0
+    comp = json.loads((tmp_path / "out" / "compensated.json").read_text())
+    assert comp["compensation"]["gamma_shift"] == pytest.approx(0.1, abs=0.02)
+
+
+def test_also_without_compensate(files, capsys, tmp_path):
+    folder, width = files
+    scan = str(folder / "scan.npy")
+    argv = [
+        "measure", scan, "--design", str(folder / "design.json"), "--radius", "0.5mm",
+        "--size", f"{width * 1e3}mm", "--height-unit", "um", "--loads", "2",
+        "--also", scan, str(folder / "design.json"), "--out", str(tmp_path / "out"),
+    ]  # fmt: skip
+    assert main(argv) == 2
+    assert "compensate" in capsys.readouterr().err

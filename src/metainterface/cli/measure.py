@@ -45,6 +45,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="also write compensated.json, the geometry to print next",
     )
+    p.add_argument(
+        "--also",
+        nargs=2,
+        action="append",
+        default=[],
+        metavar=("SCAN", "DESIGN"),
+        help="with --compensate: another scan of the same print and the design it was "
+        "printed from, whose asperities join the map from designed to made (repeatable)",
+    )
     p.add_argument("--loads", type=int, default=8, help="BEM loads (default 8)")
     p.add_argument(
         "--grid",
@@ -83,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
         out=args.out,
         compensate=args.compensate,
         device=args.device,
+        also=[tuple(pair) for pair in args.also],
     )
     print(repr(result))
     return 0

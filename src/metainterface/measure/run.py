@@ -5,9 +5,12 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import os
+from collections.abc import Sequence
 from typing import Any
 
 from metainterface.errors import MetainterfaceError
+from metainterface.measure.compensate import compensate as compensate_design
+from metainterface.measure.compensate import fit_map
 from metainterface.measure.predict import predict
 from metainterface.measure.register import register
 from metainterface.measure.result import Friction, MeasureResult
@@ -33,6 +36,7 @@ def measure(
     compensate: bool = False,
     out: str | os.PathLike[str] | None = None,
     device: Any = "auto",
+    also: Sequence[tuple[Any, Design | str | os.PathLike[str]]] = (),
 ) -> MeasureResult:
     """Measure a made part: read, level and register its scan, fit every asperity of every
     cell, and predict its friction law (BEM on the measured cell, and the forward model with
@@ -49,13 +53,17 @@ def measure(
     compensate: also design the next print (``MeasureResult.compensation``; the same as
     ``.compensate()`` later). out: a folder to write measured.json, bem.csv, measured.png
     (and compensated.json) in (``MeasureResult.write``). device: where the BEM runs
-    ("auto", "cpu", "cuda", "cuda:N").
+    ("auto", "cpu", "cuda", "cuda:N"). also: more (scan, design) pairs of the same print
+    (read as ``scan`` is), registered only, whose made asperities join this one's in the
+    map from designed to made that ``compensate`` fits.
 
     Returns a :class:`MeasureResult` (``.registration``, ``.prediction``, ``.error``,
     ``.compensate()``, ``.write(folder)``). Raises MetainterfaceError in one line: unknown
     format, no lateral size, a scan smaller than one lattice cell, one that does not show
     this design's lattice.
     """
+    if also and not compensate:
+        raise MetainterfaceError("also gives more scans for compensate; set compensate=True")
     if not isinstance(design, Design):
         design = Design.load(design)
     read: dict[str, Any] = {}
@@ -92,7 +100,14 @@ def measure(
         scan=s, design=design, registration=reg, prediction=pred, friction=friction
     )
     if compensate:
-        result = dataclasses.replace(result, compensation=result.compensate(model=model))
+        pairs = [(design, reg)]
+        for other_scan, other_design in also:
+            d = other_design if isinstance(other_design, Design) else Design.load(other_design)
+            other = as_scan(other_scan, radius=radius, pixel_size=pixel_size, **read)
+            pairs.append((d, register(other, d)))
+        comp = compensate_design(design, fit_map(pairs), model=model)
+        result = dataclasses.replace(result, compensation=comp)
+
     if out is not None:
         result.write(out)
     return result
