@@ -29,6 +29,7 @@ RANKS = {
     "sweep": 5,
     # 5, not above designer: robust design draws its manufacturing errors from here
     "manufacture": 5,
+    "measure": 6,
     "api": 7,
     "__init__": 7,  # the lazy face, ``import metainterface as mi``
     "reproduce": 7,

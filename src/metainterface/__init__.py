@@ -39,6 +39,11 @@ Checking and making
     write_result, export
 Looking at a design
     view (an interactive, self-contained HTML page; the [view] extra), DesignResult.figure
+The part as made
+    measure, MeasureResult
+    (a scan of the made part in, registered to its design, every asperity fitted, its law
+    predicted by BEM; .compensate(): the geometry to print next so that the made part
+    meets the target; the [measure] extra reads the scan)
 Manufacturing errors
     tolerance, ToleranceResult (the band of alpha(P*) and the error under height, shape and
     scale errors), min_radius, PrinterSizing (the smallest R for a printer's height error);
@@ -123,6 +128,8 @@ _HOMES: dict[str, str] = {
     "FeasibleScale": "metainterface.scaling.search",
     "BemCheck": "metainterface.verify.check",
     "Verify": "metainterface.verify.check",
+    "measure": "metainterface.measure.run",
+    "MeasureResult": "metainterface.measure.result",
 }
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
@@ -143,6 +150,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.inverse.verdict import reachability
     from metainterface.manufacture.sizing import PrinterSizing, min_radius
     from metainterface.manufacture.tolerance import ToleranceResult, tolerance
+    from metainterface.measure.result import MeasureResult
+    from metainterface.measure.run import measure
     from metainterface.physics.cell import CellSettings, Design
     from metainterface.physics.models import (
         MODELS,
@@ -208,6 +217,7 @@ __all__ = [
     "ForwardModel",
     "Independent",
     "Interacting",
+    "MeasureResult",
     "MetainterfaceError",
     "PrinterSizing",
     "ReachWarning",
@@ -231,6 +241,7 @@ __all__ = [
     "feasible_scale",
     "generate_dataset",
     "get_model",
+    "measure",
     "min_radius",
     "physical",
     "pressure_check",

@@ -34,13 +34,14 @@ COMMANDS: tuple[str, ...] = (
     "validate",
     "reproduce",
     "view",
+    "measure",
 )
 
 #: Commands whose files are written as one set, all or none (the others write as they go,
 #: so that an interrupted run resumes: train's checkpoints, reproduce's stages, a sweep).
 #: design's files are one set inside mi.design / mi.compare already, so that --html can
 #: read them back to make the page (a file staged in a set is not there yet).
-ALL_OR_NOTHING = frozenset({"curve", "export", "generate", "evaluate"})
+ALL_OR_NOTHING = frozenset({"curve", "export", "generate", "evaluate", "measure"})
 
 #: Commands whose torch work is large batched kernels (all of torch's threads where they
 #: sleep while waiting); the others run on one thread a process (metainterface._threads).

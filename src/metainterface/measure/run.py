@@ -1,0 +1,130 @@
+"""``mi.measure``: a scan in, the made part registered, its law predicted."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import os
+from collections.abc import Sequence
+from typing import Any
+
+from metainterface.errors import MetainterfaceError
+from metainterface.measure.compensate import compensate as compensate_design
+from metainterface.measure.compensate import fit_map
+from metainterface.measure.predict import predict
+from metainterface.measure.register import register
+from metainterface.measure.result import Friction, MeasureResult
+from metainterface.measure.scan import as_scan
+from metainterface.physics.cell import Design
+
+
+def measure(
+    scan: Any,
+    design: Design | str | os.PathLike[str],
+    *,
+    radius: Any,
+    pixel_size: Any = None,
+    size: Any = None,
+    height_unit: str | None = None,
+    modulus: Any = None,
+    shear_strength: Any = None,
+    area: Any = None,
+    grid: int | None = None,
+    loads: int = 8,
+    model: Any = None,
+    progress: bool = True,
+    compensate: bool = False,
+    out: str | os.PathLike[str] | None = None,
+    device: Any = "auto",
+    also: Sequence[tuple[Any, Design | str | os.PathLike[str]]] = (),
+) -> MeasureResult:
+    """Measure a made part: read, level and register its scan, fit every asperity of every
+    cell, and predict its friction law (BEM on the measured cell, and the forward model with
+    the fitted asperities) against the design's target.
+
+    scan: a file SurfaceTopography reads (X3P, SUR, OPD, DATX, GWY, NPY, text, ...; the
+    ``measure`` extra), a (ny, nx) array (rows along y; give ``pixel_size``) or a Scan.
+    design: the Design (or design file) that was printed. radius: R, e.g. "0.5mm" (a number
+    is metres). size, height_unit: the scan's lateral size and height unit where its file
+    has none (an array's heights are in ``height_unit``, default metres). modulus,
+    shear_strength, area: E* [Pa], tau [Pa], nominal area [m^2] (all three or none), for
+    friction in newtons. grid: the measured cell's BEM grid (default: the scan's own
+    resolution, 64 n to 256 n). loads: BEM loads. progress: a bar over the BEM loads.
+    compensate: also design the next print (``MeasureResult.compensation``; the same as
+    ``.compensate()`` later). out: a folder to write measured.json, bem.csv, measured.png
+    (and compensated.json) in (``MeasureResult.write``). device: where the BEM runs
+    ("auto", "cpu", "cuda", "cuda:N"). also: more (scan, design) pairs of the same print
+    (read as ``scan`` is), registered only, whose made asperities join this one's in the
+    map from designed to made that ``compensate`` fits.
+
+    Returns a :class:`MeasureResult` (``.registration``, ``.prediction``, ``.error``,
+    ``.compensate()``, ``.write(folder)``). Raises MetainterfaceError in one line: unknown
+    format, no lateral size, a scan smaller than one lattice cell, one that does not show
+    this design's lattice.
+    """
+    if also and not compensate:
+        raise MetainterfaceError("also gives more scans for compensate; set compensate=True")
+    if not isinstance(design, Design):
+        design = Design.load(design)
+    read: dict[str, Any] = {}
+    if size is not None:
+        read["size"] = size
+    if height_unit is not None:
+        read["height_unit"] = height_unit
+    if "size" in read and not isinstance(scan, str | os.PathLike):
+        raise MetainterfaceError("size is for a scan file; an array takes pixel_size")
+    s = as_scan(scan, radius=radius, pixel_size=pixel_size, **read)
+    friction = _friction(modulus, shear_strength, area)
+    if isinstance(loads, bool) or not isinstance(loads, int) or not 2 <= loads <= 200:
+        raise MetainterfaceError(f"loads must be a whole number in [2, 200], got {loads!r}")
+    if out is not None:
+        from metainterface._files.atomic import check_output_folder
+
+        check_output_folder(out)  # before the work, not after
+    if grid is not None:
+        from metainterface.validation import check_grid
+
+        grid = check_grid(grid, design.settings)
+    reg = register(s, design)
+    with contextlib.ExitStack() as stack:
+        report = None
+        if progress:
+            from tqdm.auto import tqdm
+
+            bar = stack.enter_context(tqdm(total=loads, desc="BEM loads", unit="load"))
+            report = bar.update
+        pred = predict(
+            s, reg, design, grid=grid, loads=loads, model=model, report=report, device=device
+        )
+    result = MeasureResult(
+        scan=s, design=design, registration=reg, prediction=pred, friction=friction
+    )
+    if compensate:
+        pairs = [(design, reg)]
+        for other_scan, other_design in also:
+            d = other_design if isinstance(other_design, Design) else Design.load(other_design)
+            other = as_scan(other_scan, radius=radius, pixel_size=pixel_size, **read)
+            pairs.append((d, register(other, d)))
+        comp = compensate_design(design, fit_map(pairs), model=model)
+        result = dataclasses.replace(result, compensation=comp)
+
+    if out is not None:
+        result.write(out)
+    return result
+
+
+def _friction(modulus: Any, shear_strength: Any, area: Any) -> Friction | None:
+    given = [v is not None for v in (modulus, shear_strength, area)]
+    if not any(given):
+        return None
+    if not all(given):
+        raise MetainterfaceError(
+            "friction in newtons needs modulus, shear_strength and area together"
+        )
+    from metainterface.units import parse_area, parse_pressure
+
+    return Friction(
+        modulus=parse_pressure(modulus, option="modulus"),
+        shear_strength=parse_pressure(shear_strength, option="shear_strength"),
+        area=parse_area(area, option="area"),
+    )
