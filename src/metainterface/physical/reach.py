@@ -44,13 +44,18 @@ TOLERANCE = 0.05
 
 
 def alpha_bounds(
-    p_star: np.ndarray, settings: CellSettings | None = None
+    p_star: np.ndarray, settings: CellSettings | None = None, adhesion: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """(lo, hi, P*_reach): the contact fraction any cell of ``settings`` reaches at each
     pressure p_star (M,), and the largest pressure any reaches (lo = inf, hi = -inf beyond
-    it, and at P* <= 0)."""
+    it, and at P* <= 0). adhesion: w [E* R] (``physical.adhesive_reach``), 0 for none."""
     s = settings or CellSettings()
-    force, lo_n, hi_n = _envelope(s)
+    if adhesion:
+        from metainterface.physical.adhesive_reach import adhesive_envelope
+
+        force, lo_n, hi_n = adhesive_envelope(s, float(adhesion))
+    else:
+        force, lo_n, hi_n = _envelope(s)
     p = np.asarray(p_star, dtype=np.float64)
     f = p * s.nominal_area
     reach = float(force[-1] / s.nominal_area)
@@ -159,17 +164,19 @@ def reachability(
     area: float = 1.0,
     settings: CellSettings | None = None,
     units: bool = True,
+    adhesion: float = 0.0,
 ) -> Reachability:
     """Whether a friction law (K,) [N] is reachable at tau [Pa], E* [Pa] and a nominal area
     [m^2] by cells of ``settings``. With ``units=False`` the inputs are P* and alpha (and
-    tau = E* = A = 1): the same test on a dimensionless target."""
+    tau = E* = A = 1): the same test on a dimensionless target. adhesion: w / (E* R), for
+    cells of JKR asperities."""
     fn = np.asarray(normal_force, dtype=np.float64)
     ff = np.asarray(friction_force, dtype=np.float64)
     keep = fn > 0
     fn, ff = fn[keep], ff[keep]
     p = fn / (area * e_star)
     alpha = ff / (shear_strength * area)
-    lo, hi, p_reach = alpha_bounds(p, settings)
+    lo, hi, p_reach = alpha_bounds(p, settings, adhesion)
     to_mu = shear_strength / e_star  # mu = (alpha / P*) tau / E*
     law_mu = ff / fn
     within = p <= p_reach
