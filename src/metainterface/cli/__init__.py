@@ -34,6 +34,7 @@ COMMANDS: tuple[str, ...] = (
     "validate",
     "reproduce",
     "view",
+    "calibrate",
 )
 
 #: Commands whose files are written as one set, all or none (the others write as they go,
