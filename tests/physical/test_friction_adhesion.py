@@ -136,3 +136,22 @@ def test_offset_law_designed_within_two_percent(tmp_path):
         result = mi.design(target, seed=0)
     assert result.model.adhesion == pytest.approx(W)
     assert result.error < 0.02
+
+
+def test_friction_law_designs_say_what_adhesion_would_change(tmp_path):
+    """Item 6: a friction-law design without adhesion states how much a typical w would
+    change its law; one with adhesion states its pull-off force."""
+    fn = np.linspace(0.2, 2.0, 12)
+    path = _write(tmp_path, fn, 0.9 * fn**0.8)
+    scale = dict(shear_strength="0.06MPa", modulus=E, radius=R, area=AREA)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = mi.design(mi.Target.from_friction(path, **scale), verify=False, refine=False)
+        sticky = mi.design(
+            mi.Target.from_friction(path, work_of_adhesion=W_J, **scale),
+            verify=False,
+            refine=False,
+        )
+    note = [n for n in plain.notes if n.startswith("adhesion:")]
+    assert len(note) == 1 and "at w = 50 mJ/m^2" in note[0] and "at zero load" in note[0]
+    assert any(n.startswith("adhesion: pull-off force") for n in sticky.notes)

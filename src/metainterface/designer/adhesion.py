@@ -56,3 +56,65 @@ def model_for_targets(model: ForwardModel, targets: Sequence[Any]) -> ForwardMod
             argument="model",
         )
     return dataclasses.replace(model, adhesion=w)
+
+
+#: The work of adhesion a friction-law design without one is checked at [J/m^2]: typical of
+#: the elastomers these parts are moulded or printed in (PDMS, silicones, TPU) on glass or
+#: a polished counterface, 40-70 mJ/m^2 (issue 38, item 6).
+STATED_WORK_OF_ADHESION = 0.05
+
+
+def adhesion_notes(
+    result: Any, work_of_adhesion: float = STATED_WORK_OF_ADHESION
+) -> tuple[str, ...]:
+    """Notes on adhesion for a design of a friction law (none for other targets).
+
+    With adhesion: the cell's pull-off force over the interface (how sticky it feels).
+    Without: how much a work of adhesion ``work_of_adhesion`` [J/m^2] would change the
+    design's friction at the law's smallest and largest loads, and at zero load, so a
+    user who leaves adhesion out sees when that is unsafe.
+    """
+    import numpy as np
+    import torch
+
+    from metainterface.physics.adhesion import ADHESION_LIMIT
+
+    friction = (getattr(result.target, "meta", None) or {}).get("friction")
+    if not isinstance(friction, dict) or "e_star_pa" not in friction:
+        return ()
+    e_star, radius = float(friction["e_star_pa"]), float(friction["radius_m"])
+    tau, area = float(friction["shear_strength_pa"]), float(friction["area_m2"])
+    design, model = result.design, result.model
+    gamma, h = design.tensors(torch.float64)
+    s = design.settings
+    if model.adhesion:
+        p_off = model.design_pull_off(design)
+        return (
+            f"adhesion: pull-off force {p_off * e_star * area:.3g} N over the interface "
+            f"(P*_off = {p_off:.3g}, w = {friction.get('work_of_adhesion_j_m2', 0) * 1e3:.3g} "
+            "mJ/m^2)",
+        )
+    w = work_of_adhesion / (e_star * radius)
+    if not 0 < w <= ADHESION_LIMIT or not dataclasses.is_dataclass(model):
+        return ()
+    sticky = dataclasses.replace(model, adhesion=w)
+    p = np.asarray(result.target.p_star, dtype=np.float64)
+    p = p[p > 0]
+    if p.size == 0:
+        return ()
+    loads = torch.as_tensor(np.array([p[0], p[-1]]))[None]
+    try:
+        with torch.no_grad():
+            plain = model.alpha_at_loads(gamma, h, s, loads)[0].numpy()
+            adh = sticky.alpha_at_loads(gamma, h, s, loads)[0].numpy()
+            zero = sticky.alpha_at_loads(gamma, h, s, loads[:, :1] * 1e-9)[0, 0].item()
+    except MetainterfaceError:
+        return ()
+    change = adh / np.where(plain > 0, plain, np.inf) - 1
+    fn = np.array([p[0], p[-1]]) * e_star * area
+    return (
+        f"adhesion: at w = {work_of_adhesion * 1e3:.3g} mJ/m^2 (typical of elastomers on "
+        f"glass) this design's friction would be {100 * change[1]:+.3g} % at {fn[1]:.3g} N, "
+        f"{100 * change[0]:+.3g} % at {fn[0]:.3g} N and {zero * tau * area:.3g} N at zero "
+        "load; design with --work-of-adhesion if the part's interface adheres",
+    )

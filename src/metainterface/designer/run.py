@@ -15,7 +15,7 @@ from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
 from metainterface._threads import uses_threads
-from metainterface.designer.adhesion import model_for_targets
+from metainterface.designer.adhesion import adhesion_notes, model_for_targets
 from metainterface.designer.curves import reach_note
 from metainterface.designer.given import _limit, _physical_options
 from metainterface.designer.options import Effort, Robust, Scale, merge
@@ -291,6 +291,7 @@ def design(
         device=dev,
     )
     results = [_public(r, limit, modulus) for r in raw]
+    results = [replace(r, notes=(*r.notes, *adhesion_notes(r))) for r in results]
     results = [_forced(r, reach.get(r.target.name)) for r in results]
     if perturb is not None:
         results = [_robust_stats(r, perturb, seed, dev) for r in results]
