@@ -5,7 +5,6 @@ MetainterfaceError."""
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -15,7 +14,7 @@ from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
 from metainterface._threads import uses_threads
-from metainterface.designer.adhesion import adhesion_notes, model_for_targets
+from metainterface.designer.adhesion import adhesion_notes, adhesive_bem_check, model_for_targets
 from metainterface.designer.curves import reach_note
 from metainterface.designer.given import _limit, _physical_options
 from metainterface.designer.options import Effort, Robust, Scale, merge
@@ -241,13 +240,9 @@ def design(
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
     fm = model_for_targets(get_model(model), items)
     checks = as_verify(verify, device)
-    if checks is not None and fm.adhesion:
-        warnings.warn(
-            "the BEM check of adhesive designs is not in the verify step yet "
-            "(validation.adhesive_bem checks them): skipped",
-            stacklevel=2,
-        )
-        checks = None
+    adhesive_checks = None
+    if checks is not None and fm.adhesion:  # checked in the adhesive BEM, not corrected
+        adhesive_checks, checks = checks, None
     if checks is not None:  # a bad grid or device fails now, not after the design
         checks.ready(settings or CellSettings())
     limit = _limit(max_pressure, modulus)
@@ -297,6 +292,8 @@ def design(
         results = [_robust_stats(r, perturb, seed, dev) for r in results]
     if step is not None:
         results = [_printable_record(r, radius_m) for r in results]
+    if adhesive_checks is not None:
+        results = [adhesive_bem_check(r, adhesive_checks) for r in results]
     if checks is not None:
         results = _verify_all(
             results, checks, extra_loss, refine_settings, step, perturb, limit, modulus
