@@ -158,3 +158,12 @@ def test_friction_law_designs_say_what_adhesion_would_change(tmp_path):
     note = [n for n in plain.notes if n.startswith("adhesion:")]
     assert len(note) == 1 and "at w = 50 mJ/m^2" in note[0] and "at zero load" in note[0]
     assert any(n.startswith("adhesion: pull-off force") for n in sticky.notes)
+
+
+def test_design_takes_a_work_of_adhesion_with_its_scale():
+    quick = dict(method="multistart", starts=2, refine=False, verify=False)
+    r = mi.design("bilinear", work_of_adhesion="50mJ/m2", modulus="2.4MPa", radius="0.5mm", **quick)
+    assert r.model.adhesion == pytest.approx(W)
+    assert np.isfinite(r.error)
+    with pytest.raises(MetainterfaceError, match="work_of_adhesion needs the modulus"):
+        mi.design("bilinear", work_of_adhesion="50mJ/m2", **quick)

@@ -359,6 +359,13 @@ def run(args: argparse.Namespace) -> int:
         verify=verify(args),
         **manufacturing(args),
     )
+    if args.work_of_adhesion is not None and not args.friction_csv:  # a friction law carries it
+        if args.compare:
+            raise mi.MetainterfaceError(
+                "--work-of-adhesion with --compare takes a --friction-csv target",
+                argument="--work-of-adhesion",
+            )
+        options["work_of_adhesion"] = args.work_of_adhesion
     try:
         results = _run(args, targets, options)
     except mi.UnreachableError as exc:  # two lines: what is out of reach, what would fix it

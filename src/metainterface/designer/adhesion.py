@@ -24,14 +24,42 @@ def target_adhesion(target: Any) -> float:
     return float(friction.get("adhesion", 0.0) or 0.0)
 
 
-def model_for_targets(model: ForwardModel, targets: Sequence[Any]) -> ForwardModel:
-    """``model`` with the adhesion its targets were converted with.
+def given_adhesion(
+    work_of_adhesion: str | float | None, modulus: str | float | None, radius: str | float | None
+) -> float:
+    """w / (E* R) from ``design``'s work_of_adhesion ('50mJ/m2' or J/m^2) and its scale's
+    modulus and radius (both needed: w is dimensionless only against E* R); 0 if None."""
+    if work_of_adhesion is None:
+        return 0.0
+    from metainterface.physical.units import (
+        parse_length,
+        parse_pressure,
+        parse_work_of_adhesion,
+    )
+
+    w = parse_work_of_adhesion(work_of_adhesion, option="work_of_adhesion")
+    if modulus is None or radius is None:
+        raise MetainterfaceError(
+            "work_of_adhesion needs the modulus and radius too (w / (E* R) sets the contact)",
+            argument="work_of_adhesion",
+        )
+    e_star = parse_pressure(modulus, option="modulus")
+    r = parse_length(radius, option="radius")
+    return w / (e_star * r)
+
+
+def model_for_targets(
+    model: ForwardModel, targets: Sequence[Any], adhesion: float = 0.0
+) -> ForwardModel:
+    """``model`` with the adhesion its targets were converted with (or ``adhesion``,
+    w / (E* R), given to ``design``).
 
     Targets designed in one batch share one model: their adhesions must agree (or be 0).
     A model given with an adhesion of its own keeps it; one that differs from a target's
     is an error (the law would be designed for another contact).
     """
-    values = {round(target_adhesion(t), 15) for t in targets} - {0.0}
+    values = {round(target_adhesion(t), 15) for t in targets} | {round(adhesion, 15)}
+    values -= {0.0}
     if not values:
         return model
     if len(values) > 1:

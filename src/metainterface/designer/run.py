@@ -14,7 +14,12 @@ from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
 from metainterface._threads import uses_threads
-from metainterface.designer.adhesion import adhesion_notes, adhesive_bem_check, model_for_targets
+from metainterface.designer.adhesion import (
+    adhesion_notes,
+    adhesive_bem_check,
+    given_adhesion,
+    model_for_targets,
+)
 from metainterface.designer.curves import reach_note
 from metainterface.designer.given import _limit, _physical_options
 from metainterface.designer.options import Effort, Robust, Scale, merge
@@ -107,6 +112,7 @@ def design(
     sigma_gamma: float | None = None,
     scale_sigma: float | None = None,
     robust_samples: int | None = None,
+    work_of_adhesion: str | float | None = None,
 ) -> DesignResult | list[DesignResult]:
     """Design a unit cell whose alpha(P*) follows each target, checked in BEM.
 
@@ -154,8 +160,8 @@ def design(
         With ``out``: also the whole target in target.csv; extra keys for design.json.
     starts, hedge, fallback, refine, seed, refine_settings
         One by one, the fields of ``effort``.
-    radius, modulus, total_force, area
-        One by one, the fields of ``scale``.
+    radius, modulus, total_force, area, work_of_adhesion
+        One by one, the fields of ``scale``; w ('50mJ/m2') with them: adhesion w / (E* R).
     sigma_h, sigma_gamma, scale_sigma, robust_samples
         One by one, the fields of a ``Robust`` (``robust_samples`` is its ``samples``),
         with ``robust=True``.
@@ -238,7 +244,9 @@ def design(
         raise MetainterfaceError(f"refine must be True or False, got {refine!r}")
     if not isinstance(full_target, bool):
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
-    fm = model_for_targets(get_model(model), items)
+    fm = model_for_targets(
+        get_model(model), items, given_adhesion(work_of_adhesion, modulus, radius)
+    )
     checks = as_verify(verify, device)
     adhesive_checks = None
     if checks is not None and fm.adhesion:  # checked in the adhesive BEM, not corrected
