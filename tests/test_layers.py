@@ -30,6 +30,8 @@ RANKS = {
     # 5, not above designer: robust design draws its manufacturing errors from here
     "manufacture": 5,
     "measure": 6,
+    # fits tau and w to a friction test: units and the physics, used by the face and the CLI
+    "calibration": 3,
     "api": 7,
     "__init__": 7,  # the lazy face, ``import metainterface as mi``
     "reproduce": 7,

@@ -35,6 +35,7 @@ COMMANDS: tuple[str, ...] = (
     "reproduce",
     "view",
     "measure",
+    "calibrate",
 )
 
 #: Commands whose files are written as one set, all or none (the others write as they go,

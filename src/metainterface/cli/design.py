@@ -68,6 +68,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     phys.add_argument("--radius", help="asperity radius R, e.g. 0.5mm")
     phys.add_argument(
+        "--work-of-adhesion",
+        help="work of adhesion w of the interface, e.g. 50mJ/m2 (PDMS on glass): JKR "
+        "asperities, and friction at zero load (an offset law) is accepted and kept",
+    )
+    phys.add_argument(
         "--area",
         help="nominal area of the whole interface, e.g. 4cm2; with --friction-csv also "
         "'auto' or a range (2cm2..10cm2): the area is designed with the cell (one of --area, "
@@ -223,6 +228,13 @@ def _targets(args: argparse.Namespace) -> list:
 
     targets = [mi.Target.builtin(n) for n in args.target]
     targets += [mi.Target.from_csv(f) for f in args.target_csv]
+    adhesive = getattr(args, "work_of_adhesion", None) is not None
+    if args.friction_csv and adhesive and _scale_free(args):
+        raise mi.MetainterfaceError(
+            "--work-of-adhesion takes a fixed --area, --modulus and --shear-strength "
+            "(the scale is not designed for adhesive contact yet)",
+            argument="--work-of-adhesion",
+        )
     if args.friction_csv and not _scale_free(args):
         from metainterface.inverse.targets import friction_law_target
         from metainterface.units.friction import friction_target_from_options
@@ -234,12 +246,14 @@ def _targets(args: argparse.Namespace) -> list:
             radius=args.radius,
             area=args.area,
             fit=args.fit,
+            work_of_adhesion=getattr(args, "work_of_adhesion", None),
         )
         targets.append(friction_law_target(ft, args.friction_csv))
         fit = targets[-1].meta["friction"].get("fit")
         if fit is not None:
             print(f"{targets[-1].name}: {fit['summary']}")
-        _advise(args, targets[-1].name)
+        if not adhesive:  # the scale advice is for adhesionless cells
+            _advise(args, targets[-1].name)
     if not targets:
         raise mi.MetainterfaceError("give at least one --target, --target-csv or --friction-csv")
     return targets
@@ -332,6 +346,15 @@ def run(args: argparse.Namespace) -> int:
         verify=verify(args),
         **groups(args),
     )
+    if args.work_of_adhesion is not None and not args.friction_csv:  # a friction law carries it
+        if args.compare:
+            raise mi.MetainterfaceError(
+                "--work-of-adhesion with --compare takes a --friction-csv target",
+                argument="--work-of-adhesion",
+            )
+        from dataclasses import replace
+
+        options["scale"] = replace(options["scale"], work_of_adhesion=args.work_of_adhesion)
     from metainterface._files.provenance import recording_command
 
     try:

@@ -39,6 +39,9 @@ class Scale:
         cells for it. Needs ``radius`` and ``modulus``; not with ``area``.
     area : str or float or None
         The patch's area ('4cm2', or m^2), instead of ``total_force``.
+    work_of_adhesion : str or float or None
+        w of the material pair ('50mJ/m2', or J/m^2): the design's forward model is then
+        adhesive (JKR, w / (E* R)); needs ``radius`` and ``modulus``.
 
     Examples
     --------
@@ -52,6 +55,7 @@ class Scale:
     modulus: str | float | None = None
     total_force: str | float | None = None
     area: str | float | None = None
+    work_of_adhesion: str | float | None = None
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,12 @@ from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
 from metainterface._files.provenance import current_command
 from metainterface._threads import uses_threads
+from metainterface.designer.adhesion import (
+    adhesion_notes,
+    adhesive_bem_check,
+    given_adhesion,
+    model_for_targets,
+)
 from metainterface.designer.curve_result import reach_note
 from metainterface.designer.given import _limit, _physical_options
 from metainterface.designer.options import (
@@ -173,8 +179,13 @@ def design(
         raise MetainterfaceError(f"refine must be True or False, got {refine!r}")
     if not isinstance(full_target, bool):
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
-    fm = get_model(model)
+    fm = model_for_targets(
+        get_model(model), items, given_adhesion(size["work_of_adhesion"], modulus, radius)
+    )
     checks = as_verify(verify, device)
+    adhesive_checks = None
+    if checks is not None and fm.adhesion:  # checked in the adhesive BEM, not corrected
+        adhesive_checks, checks = checks, None
     if checks is not None:  # a bad grid or device fails now, not after the design
         checks.ready(settings or CellSettings())
     limit = _limit(max_pressure, modulus)
@@ -218,11 +229,14 @@ def design(
         device=dev,
     )
     results = [_public(r, limit, modulus) for r in raw]
+    results = [replace(r, notes=(*r.notes, *adhesion_notes(r))) for r in results]
     results = [_forced(r, reach.get(r.target.name)) for r in results]
     if perturb is not None:
         results = [_robust_stats(r, perturb, seed, dev) for r in results]
     if step is not None:
         results = [_printable_record(r, radius_m) for r in results]
+    if adhesive_checks is not None:
+        results = [adhesive_bem_check(r, adhesive_checks) for r in results]
     if checks is not None:
         results = _verify_all(
             results, checks, extra_loss, refine_settings, step, perturb, limit, modulus

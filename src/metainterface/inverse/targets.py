@@ -134,6 +134,7 @@ class Target:
         settings: CellSettings | None = None,
         name: str | None = None,
         fit: str = "auto",
+        work_of_adhesion: str | float | None = None,
     ) -> Target:
         """A target from a friction law: a CSV ``normal_force,friction_force`` [N] (or
         ``normal_force,friction_coefficient``), one row per load; the header may give the
@@ -148,6 +149,9 @@ class Target:
         repeated or unsorted loads) or fewer than 10 rows by a monotone smooth fit,
         "always" or "never" force it; the fit and its residual are in
         ``meta["friction"]["fit"]``.
+        work_of_adhesion: w ('50mJ/m2' or J/m^2), for adhesive contact (JKR asperities): an
+        offset F_f(0) > 0 is then accepted and kept, and ``design`` uses the forward model
+        with adhesion w / (E* R) (``meta["friction"]["adhesion"]``).
         """
         from metainterface.units.friction import friction_target_in_units
 
@@ -159,6 +163,7 @@ class Target:
             area=area,
             settings=settings,
             fit=fit,
+            work_of_adhesion=work_of_adhesion,
         )
         return friction_law_target(ft, law, name)
 

@@ -25,6 +25,7 @@ def reachability(
     area: str | float | None = None,
     radius: str | float = "1mm",
     settings: CellSettings | None = None,
+    work_of_adhesion: str | float | None = None,
 ) -> Reachability:
     """Whether cells of ``settings`` (default: the paper's) can follow a friction law.
 
@@ -40,6 +41,9 @@ def reachability(
         Asperity radius R, only to check the area holds a unit cell (default '1mm').
     settings : CellSettings
         The design space (N, gamma bounds, Delta_max).
+    work_of_adhesion : str or float
+        w ('50mJ/m2', J/m^2) for adhesive contact (JKR asperities), with a law or CSV (a
+        Target carries its own); then R sets w / (E* R) and should be the part's.
 
     Returns
     -------
@@ -74,6 +78,7 @@ def reachability(
         radius=radius,
         area=area,
         settings=settings,
+        work_of_adhesion=work_of_adhesion,
     )
     return _reachability(
         ft.law.normal_force,
@@ -82,6 +87,7 @@ def reachability(
         e_star=ft.e_star,
         area=ft.area,
         settings=settings,
+        adhesion=ft.adhesion,
     )
 
 
@@ -99,6 +105,7 @@ def target_reachability(target: Target, settings: CellSettings | None = None) ->
             e_star=e_star,
             area=a,
             settings=settings,
+            adhesion=float(f.get("adhesion", 0.0) or 0.0),
         )
     return _reachability(target.p_star, target.alpha, settings=settings, units=False)
 

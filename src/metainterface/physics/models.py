@@ -5,6 +5,9 @@ A forward model maps (B, N) designs to their response along a Delta sweep. Two s
     Independent()                 the paper's superposition of Sneddon contacts (sec. 2.2)
     Interacting(curvature=False)  the same with the lattice's elastic field (``interaction``)
 
+Both take ``adhesion=w`` (work of adhesion in units of E* R): JKR asperities, the loading
+curve under a rising force, and an unloading branch and pull-off force (``physics.adhesion``).
+
 Each implements ``sweep`` and ``asperity_sweep`` (and may give a cheaper ``load_area``);
 everything else (curves, alpha at given pressures, the dense curve that BEM results are
 compared with) is derived once, in :class:`ForwardModel`. ``MODELS`` maps names to
@@ -23,6 +26,7 @@ from torch import Tensor
 
 from metainterface._names import DEFAULT_MODEL
 from metainterface.errors import MetainterfaceError
+from metainterface.physics import adhesion as jkr
 from metainterface.physics import curves, pressures
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.curves import Curve, Sweep, anchor, delta_grid, to_grid
@@ -30,6 +34,7 @@ from metainterface.physics.interaction import (
     CURVATURE,
     ITERATIONS,
     asperity_sweep_interacting,
+    interaction,
     load_area_interacting,
     sweep_interacting,
 )
@@ -83,6 +88,9 @@ class ForwardModel(ABC):
     #: Whether the response depends on which lattice cell each asperity sits in (then the
     #: refinement keeps asperity k in cell k; otherwise it may reorder them freely).
     placed: bool = True
+    #: Work of adhesion w [E* R] (w_phys = w E* R); 0: adhesionless contact. An adhesive
+    #: model's curve is the loading curve under a rising force (``physics.adhesion``).
+    adhesion: float = 0.0
 
     @abstractmethod
     def sweep(
@@ -134,6 +142,66 @@ class ForwardModel(ABC):
             if getattr(self, f.name) != f.default
         ]
         return f"{self.name}({', '.join(opts)})" if opts else self.name
+
+    # --- adhesion: the unloading branch and the pull-off force ---------------------------
+
+    def adhesion_kernel(self, settings: CellSettings, dtype: torch.dtype, device) -> Tensor | None:
+        """The (N, N) interaction matrix the adhesive solve uses (None: independent)."""
+        return None
+
+    def unloading(
+        self, gamma: Tensor, h: Tensor, settings: CellSettings, *, n_delta: int = 1025
+    ) -> Sweep:
+        """The unloading branch from Delta_max of (B, N) designs under a falling force:
+        delta (B, K) descending, P* (B, K) (negative: a pull) and alpha (B, K)
+        (``physics.adhesion.unloading_adhesive``; without adhesion, the loading curve
+        reversed: adhesionless contact has no hysteresis)."""
+        if not self.adhesion:
+            delta = torch.linspace(
+                settings.delta_max, 0.0, n_delta, dtype=gamma.dtype, device=gamma.device
+            )
+            sw = self.load_area(gamma, h, settings, delta=delta)
+            return Sweep(
+                delta=delta.expand_as(sw.p_star),
+                p_star=sw.p_star,
+                alpha=sw.alpha,
+                stiffness=torch.full_like(sw.p_star, float("nan")),
+            )
+        kernel = self.adhesion_kernel(settings, gamma.dtype, gamma.device)
+        return jkr.unloading_adhesive(
+            gamma, h, settings, self.adhesion, n_delta=n_delta, kernel=kernel, **self._jkr_opts()
+        )
+
+    def pull_off(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Tensor:
+        """The pull-off pressure P*_off = -min F / (A_nom E*) >= 0 (B,) after loading to
+        Delta_max: how sticky the part feels (0 without adhesion). Multiply by A_nom E*
+        for a force per cell, by E* for a pull per nominal area."""
+        if not self.adhesion:
+            return torch.zeros_like(gamma[:, 0])
+        kernel = self.adhesion_kernel(settings, gamma.dtype, gamma.device)
+        return jkr.pull_off(gamma, h, settings, self.adhesion, kernel=kernel, **self._jkr_opts())
+
+    def design_pull_off(self, design: Design) -> float:
+        """The pull-off pressure P*_off of one design (see :meth:`pull_off`)."""
+        gamma, h = design.tensors(torch.float64)
+        with torch.no_grad():
+            return float(self.pull_off(gamma, h, design.settings)[0])
+
+    def _jkr_opts(self) -> dict:
+        return {}
+
+    def _adhesive_sweep(self, gamma, h, settings, *, n_delta=None, delta=None):
+        kernel = self.adhesion_kernel(settings, gamma.dtype, gamma.device)
+        return jkr.sweep_adhesive(
+            gamma,
+            h,
+            settings,
+            self.adhesion,
+            n_delta=n_delta,
+            delta=delta,
+            kernel=kernel,
+            **self._jkr_opts(),
+        )
 
     # --- derived, the same for every model -----------------------------------------------
 
@@ -221,15 +289,29 @@ class ForwardModel(ABC):
 
 @dataclass(frozen=True, repr=True)
 class Independent(ForwardModel):
-    """The paper's model: independent Sneddon asperities, summed (sec. 2.2)."""
+    """The paper's model: independent Sneddon asperities, summed (sec. 2.2).
+
+    adhesion: work of adhesion w [E* R], 0 by default; w > 0 makes each asperity a JKR
+    contact (``physics.adhesion``) and the curve the loading curve under a rising force
+    (``smooth`` is then not used: snap-in at touch is a jump whatever the smoothing).
+    """
+
+    adhesion: float = 0.0
 
     name = "independent"
     placed = False
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "adhesion", jkr.check_adhesion(self.adhesion))
+
     def sweep(self, gamma, h, settings, *, smooth=None, n_delta=None, delta=None) -> Sweep:
+        if self.adhesion:
+            return self._adhesive_sweep(gamma, h, settings, n_delta=n_delta, delta=delta)[0]
         return curves.sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta)
 
     def asperity_sweep(self, gamma, h, settings, *, n_delta=None, delta=None):
+        if self.adhesion:
+            return self._adhesive_sweep(gamma, h, settings, n_delta=n_delta, delta=delta)
         if delta is None:
             delta = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
         sw = curves.sweep(gamma, h, settings, delta=delta)
@@ -247,6 +329,7 @@ class Interacting(ForwardModel):
 
     curvature: bool = CURVATURE
     iterations: int = ITERATIONS
+    adhesion: float = 0.0
 
     name = "interacting"
     placed = True
@@ -260,22 +343,43 @@ class Interacting(ForwardModel):
             raise MetainterfaceError(
                 f"iterations must be a whole number in [1, 100], got {self.iterations!r}"
             )
+        object.__setattr__(self, "adhesion", jkr.check_adhesion(self.adhesion))
+        if self.adhesion and self.curvature:
+            raise MetainterfaceError(
+                "curvature must be False with adhesion (the adhesive interaction is the tip "
+                "shift only)",
+                argument="curvature",
+            )
+
+    def adhesion_kernel(self, settings, dtype, device):
+        return interaction(settings, dtype=dtype, device=device, curvature=False).shift
+
+    def _jkr_opts(self) -> dict:
+        # the adhesive solve is a Jacobi iteration (no Newton coupling): at least its own
+        # default number of sweeps
+        return {"iterations": max(self.iterations, jkr.ITERATIONS)}
 
     def _opts(self) -> dict:
         return {"curvature": self.curvature, "iterations": self.iterations}
 
     def sweep(self, gamma, h, settings, *, smooth=None, n_delta=None, delta=None) -> Sweep:
+        if self.adhesion:
+            return self._adhesive_sweep(gamma, h, settings, n_delta=n_delta, delta=delta)[0]
         return sweep_interacting(
             gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta, **self._opts()
         )
 
     def load_area(self, gamma, h, settings, *, smooth=None, n_delta=None, delta=None) -> Sweep:
+        if self.adhesion:
+            return self._adhesive_sweep(gamma, h, settings, n_delta=n_delta, delta=delta)[0]
         d, p, a = load_area_interacting(
             gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta, **self._opts()
         )
         return Sweep(delta=d, p_star=p, alpha=a, stiffness=torch.full_like(p, float("nan")))
 
     def asperity_sweep(self, gamma, h, settings, *, n_delta=None, delta=None):
+        if self.adhesion:
+            return self._adhesive_sweep(gamma, h, settings, n_delta=n_delta, delta=delta)
         return asperity_sweep_interacting(
             gamma, h, settings, n_delta=n_delta, delta=delta, **self._opts()
         )

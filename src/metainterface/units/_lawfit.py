@@ -15,6 +15,10 @@ bilinear or anything monotone; the spline assumes only smoothness. The number of
 knots (uniform in F_n) is chosen by generalised cross-validation, GCV = K RSS / (K - p)^2
 (Craven and Wahba 1979) with p the free coefficients (those not held at the bound), so
 noisy data get few knots and clean dense data more.
+
+With adhesion (``offset=True``) friction need not vanish with the load: c_0 >= 0 is then a
+free coefficient too (B-splines sum to 1, so it is a constant added to the law), still a
+convex non-negative least squares, and the fit keeps the offset F_f(0) = c_0.
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ class LawFit:
     raw_friction: np.ndarray
     residual_rms: float
     interior_knots: int
+    offset: bool = False
 
     def __call__(self, normal_force: np.ndarray) -> np.ndarray:
         """The fitted friction force [N] at loads (M,) [N] in [0, max F_n]."""
@@ -59,7 +64,8 @@ class LawFit:
         """(F_n, F_f) (points,) [N]: the fit on uniform loads over [0, max F_n]."""
         fn = np.linspace(0.0, float(self.raw_normal.max()), points)
         ff = np.maximum.accumulate(np.maximum(self(fn), 0.0))  # exact monotone to round-off
-        ff[0] = 0.0
+        if not self.offset:
+            ff[0] = 0.0
         return fn, ff
 
     def summary(self) -> str:
@@ -84,24 +90,35 @@ def _basis(x: np.ndarray, knots: np.ndarray) -> np.ndarray:
     return BSpline.design_matrix(x, knots, 3, extrapolate=False).toarray()
 
 
-def _fit(x: np.ndarray, y: np.ndarray, interior: int) -> tuple[np.ndarray, np.ndarray, int]:
-    """(knots, coef, free coefficients) of the monotone fit with ``interior`` knots."""
+def _fit(
+    x: np.ndarray, y: np.ndarray, interior: int, offset: bool = False
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """(knots, coef, free coefficients) of the monotone fit with ``interior`` knots; with
+    ``offset`` c_0 >= 0 is free (a constant added), else c_0 = 0."""
     from scipy.optimize import lsq_linear
 
     knots = _knots(float(x.max()), interior)
     b = _basis(x, knots)
     # c = L d with c_0 = 0: column j of B L is the sum of B's columns j..end
     cum = np.cumsum(b[:, ::-1], axis=1)[:, ::-1][:, 1:]
+    if offset:  # the constant c_0: the sum of all basis columns, 1 on [0, max F_n]
+        cum = np.concatenate([b.sum(axis=1, keepdims=True), cum], axis=1)
     scale = max(float(np.abs(y).max()), 1e-300)
     sol = lsq_linear(cum, y / scale, bounds=(0.0, np.inf), method="bvls")
     d = sol.x * scale
-    coef = np.concatenate([[0.0], np.cumsum(d)])
-    free = int(np.count_nonzero(d > 1e-10 * scale))
+    c0 = 0.0
+    if offset:
+        c0, d = float(d[0]), d[1:]
+    coef = c0 + np.concatenate([[0.0], np.cumsum(d)])
+    free = int(np.count_nonzero(d > 1e-10 * scale)) + int(offset and c0 > 1e-10 * scale)
     return knots, coef, free
 
 
-def fit_law(normal_force: np.ndarray, friction_force: np.ndarray) -> LawFit:
-    """The monotone spline through (F_n, F_f) data (K,) [N]: any order, repeats allowed.
+def fit_law(
+    normal_force: np.ndarray, friction_force: np.ndarray, *, offset: bool = False
+) -> LawFit:
+    """The monotone spline through (F_n, F_f) data (K,) [N]: any order, repeats allowed;
+    with ``offset`` (adhesion) F_f(0) >= 0 is fitted too, else pinned at 0.
 
     Needs at least 3 rows with a positive load; loads >= 0 and finite (checked by the caller).
     """
@@ -115,13 +132,13 @@ def fit_law(normal_force: np.ndarray, friction_force: np.ndarray) -> LawFit:
         # points pull in knots that follow the noise
         if 2 * (interior + 3) > distinct:
             break
-        knots, coef, free = _fit(x, y, interior)
+        knots, coef, free = _fit(x, y, interior, offset)
         rss = float(np.sum((_basis(x, knots) @ coef - y) ** 2))
         gcv = k * rss / max(k - free, 1) ** 2
         if best is None or gcv < best[0] * (1 - 1e-9):
             best = (gcv, interior, knots, coef, rss)
     if best is None:  # fewer than 6 distinct loads: one cubic piece anyway
-        knots, coef, _ = _fit(x, y, 0)
+        knots, coef, _ = _fit(x, y, 0, offset)
         best = (0.0, 0, knots, coef, float(np.sum((_basis(x, knots) @ coef - y) ** 2)))
     _, interior, knots, coef, rss = best
     return LawFit(
@@ -131,4 +148,5 @@ def fit_law(normal_force: np.ndarray, friction_force: np.ndarray) -> LawFit:
         raw_friction=y,
         residual_rms=float(np.sqrt(rss / k)),
         interior_knots=interior,
+        offset=offset,
     )

@@ -11,8 +11,13 @@ The curve comes from a CSV with a header and one row per load, in newtons:
 header may give the force unit (``normal_force [mN]``), and the file may be separated by ';'
 or tabs with decimal commas (:func:`metainterface._files.columns.read_table`).
 With tau > 0, A_real and so F_f can only grow with the load: a friction force that decreases
-as the load increases, friction at zero load (adhesion is not modelled) or a real area larger
+as the load increases, friction at zero load (without adhesion) or a real area larger
 than the nominal one is an error naming the row.
+
+With a work of adhesion w [J/m^2] (``work_of_adhesion``) the asperities are JKR contacts
+(``physics.adhesion``): the real area, and so friction, is finite at zero load, and an
+offset law F_f(0) > 0 is accepted and kept by the fit. The design then uses the forward
+model with ``adhesion = w / (E* R)`` (``FrictionTarget.adhesion``).
 """
 
 from __future__ import annotations
@@ -127,18 +132,20 @@ def _check_values(source: Any, name: str, values: np.ndarray) -> None:
             raise MetainterfaceError(f"{source}: row {i}: {name} = {v:g}; must be finite and >= 0")
 
 
-def check_law(law: FrictionLaw) -> None:
-    """Raise MetainterfaceError, naming the row, if the curve is impossible with tau > 0."""
+def check_law(law: FrictionLaw, *, offset: bool = False) -> None:
+    """Raise MetainterfaceError, naming the row, if the curve is impossible with tau > 0;
+    ``offset`` (adhesion): friction at zero load is allowed."""
     fn, ff, rows, src = law.normal_force, law.friction_force, law.rows, law.source
     if fn.size < 2:
         raise MetainterfaceError(f"{src}: need at least 2 rows, got {fn.size}")
     _check_values(src, "normal_force", fn)
     _check_values(src, "friction_force", ff)
     for k in range(fn.size):
-        if fn[k] == 0 and ff[k] > 0:
+        if fn[k] == 0 and ff[k] > 0 and not offset:
             raise MetainterfaceError(
                 f"{src}: row {rows[k]}: friction {ff[k]:g} N at zero normal force; with "
-                f"F_f = tau A_real (no adhesion) friction vanishes with the load"
+                f"F_f = tau A_real (no adhesion) friction vanishes with the load (give "
+                f"--work-of-adhesion for an adhesive contact)"
             )
         if k == 0:
             continue
@@ -223,6 +230,12 @@ class FrictionTarget:
     n_cells: float
     settings: CellSettings = field(default_factory=CellSettings)
     fit: LawFit | None = None
+    work_of_adhesion: float = 0.0
+
+    @property
+    def adhesion(self) -> float:
+        """w / (E* R): the work of adhesion in the core's units (``Independent(adhesion=)``)."""
+        return self.work_of_adhesion / (self.e_star * self.radius)
 
     def columns(self) -> dict[str, np.ndarray]:
         """{'p_star', 'alpha'}: the target as the design command's CSV columns."""
@@ -240,6 +253,11 @@ class FrictionTarget:
             "normal_force_n": [float(v) for v in self.law.normal_force],
             "friction_force_n": [float(v) for v in self.law.friction_force],
             **({} if self.fit is None else {"fit": fit_record(self.fit)}),
+            **(
+                {"work_of_adhesion_j_m2": self.work_of_adhesion, "adhesion": self.adhesion}
+                if self.work_of_adhesion
+                else {}
+            ),
         }
 
 
@@ -257,23 +275,24 @@ def fit_record(fit: LawFit) -> dict[str, Any]:
 
 
 def prepare_law(
-    law: FrictionLaw | str | os.PathLike[str], fit: str = "auto"
+    law: FrictionLaw | str | os.PathLike[str], fit: str = "auto", *, offset: bool = False
 ) -> tuple[FrictionLaw, LawFit | None]:
     """The law to design for, and the fit when the rows were replaced by one.
 
     fit: "auto" (fit rows that are not a law as they stand, or 5 to 9 rows of a law),
-    "always" or "never" (the rows must then be a law).
+    "always" or "never" (the rows must then be a law). offset (adhesion): friction at zero
+    load is allowed, and fitted rather than pinned at 0.
     """
     if fit not in FIT_CHOICES:
         raise MetainterfaceError(f"fit must be one of {', '.join(FIT_CHOICES)}, got {fit!r}")
     if not isinstance(law, FrictionLaw):
         law = read_friction_csv(law, check=False)
     if fit == "never":
-        check_law(law)
+        check_law(law, offset=offset)
         return law, None
     if fit == "auto":
         try:
-            check_law(law)
+            check_law(law, offset=offset)
         except MetainterfaceError:
             pass
         else:
@@ -287,7 +306,7 @@ def prepare_law(
             f"{law.source}: fitting a law needs at least {MIN_POINTS} distinct positive normal "
             f"forces, got {loads.size}"
         )
-    lf = fit_law(law.normal_force, law.friction_force)
+    lf = fit_law(law.normal_force, law.friction_force, offset=offset)
     fn, ff = lf.sample()
     fitted = FrictionLaw(
         normal_force=fn, friction_force=ff, rows=np.arange(fn.size), source=law.source
@@ -305,6 +324,7 @@ def friction_target(
     settings: CellSettings | None = None,
     include_origin: bool = True,
     fit: str = "auto",
+    work_of_adhesion: float = 0.0,
 ) -> FrictionTarget:
     """Convert a friction law (a FrictionLaw or a CSV path) into the alpha(P*) target.
 
@@ -313,8 +333,12 @@ def friction_target(
     (default: the paper's), used for L. include_origin: prepend (0 N, 0 N) when the first load
     is > 0 (F_f = tau A_real vanishes with the load). fit: "auto", "always" or "never",
     when the rows are replaced by a monotone smooth fit (:func:`prepare_law`; the fit is
-    kept in ``fit``). Errors name the row.
+    kept in ``fit``). work_of_adhesion w [J/m^2] >= 0: with w > 0 friction at zero load is
+    accepted and kept, and the origin added is (0 N, F_f(0)), F_f(0) extrapolated linearly
+    from the first two rows (floored at 0). Errors name the row.
     """
+    from metainterface.physics.adhesion import ADHESION_LIMIT
+
     settings = settings or CellSettings()
     for name, value in (
         ("shear strength", shear_strength),
@@ -324,11 +348,23 @@ def friction_target(
     ):
         if not (math.isfinite(value) and value > 0):
             raise MetainterfaceError(f"{name} must be finite and > 0, got {value!r}")
-    law, lf = prepare_law(law, fit)
+    w = float(work_of_adhesion)
+    if not (math.isfinite(w) and 0 <= w <= ADHESION_LIMIT * e_star * radius):
+        raise MetainterfaceError(
+            f"work of adhesion must be in [0, {ADHESION_LIMIT * e_star * radius:g}] J/m^2 "
+            f"(up to {ADHESION_LIMIT:g} E* R), got {work_of_adhesion!r}",
+            argument="work_of_adhesion",
+        )
+    law, lf = prepare_law(law, fit, offset=w > 0)
     if include_origin and law.normal_force[0] > 0:
+        f0 = 0.0
+        if w > 0 and law.normal_force.size >= 2:  # the offset, extrapolated
+            fn, ff = law.normal_force, law.friction_force
+            slope = (ff[1] - ff[0]) / (fn[1] - fn[0])
+            f0 = float(min(max(ff[0] - slope * fn[0], 0.0), ff[0]))
         law = FrictionLaw(
             normal_force=np.concatenate([[0.0], law.normal_force]),
-            friction_force=np.concatenate([[0.0], law.friction_force]),
+            friction_force=np.concatenate([[f0], law.friction_force]),
             rows=np.concatenate([[0], law.rows]),
             source=law.source,
         )
@@ -370,6 +406,7 @@ def friction_target(
         n_cells=area / cell_area,
         settings=settings,
         fit=lf,
+        work_of_adhesion=w,
     )
 
 
@@ -382,6 +419,7 @@ def friction_target_from_options(
     area: str | None,
     settings: CellSettings | None = None,
     fit: str = "auto",
+    work_of_adhesion: str | None = None,
 ) -> FrictionTarget:
     """:func:`friction_target` from command-line strings with units ('0.25MPa', '4cm2').
 
@@ -408,6 +446,7 @@ def friction_target_from_options(
         settings=settings,
         fit=fit,
         options=True,
+        work_of_adhesion=work_of_adhesion,
     )
 
 
@@ -421,13 +460,19 @@ def friction_target_in_units(
     settings: CellSettings | None = None,
     fit: str = "auto",
     options: bool = False,
+    work_of_adhesion: str | float | None = None,
 ) -> FrictionTarget:
     """:func:`friction_target` from quantities with units ('0.25MPa', '0.5mm', '4cm2') or
     numbers in SI. A bad quantity's error names its argument (``shear_strength``), or with
     ``options`` the command-line option (``--shear-strength``); a likely unit slip
     (:mod:`.plausible`) warns."""
     from metainterface.units.plausible import warn_unit_slips
-    from metainterface.units.quantities import parse_area, parse_length, parse_pressure
+    from metainterface.units.quantities import (
+        parse_area,
+        parse_length,
+        parse_pressure,
+        parse_work_of_adhesion,
+    )
 
     def name(arg: str) -> str:
         return "--" + arg.replace("_", "-") if options else arg
@@ -437,6 +482,16 @@ def friction_target_in_units(
     r = parse_length(radius, option=name("radius"))
     a = parse_area(area, option=name("area"))
     warn_unit_slips(modulus=e_star, shear_strength=tau, radius=r)
+    w = 0.0
+    if work_of_adhesion is not None:
+        w = parse_work_of_adhesion(work_of_adhesion, option=name("work_of_adhesion"))
     return friction_target(
-        law, shear_strength=tau, e_star=e_star, radius=r, area=a, settings=settings, fit=fit
+        law,
+        shear_strength=tau,
+        e_star=e_star,
+        radius=r,
+        area=a,
+        settings=settings,
+        fit=fit,
+        work_of_adhesion=w,
     )

@@ -24,6 +24,7 @@ DIMENSIONS: dict[str, tuple[str, str, str]] = {
     "area": ("[length] ** 2", "m^2", "4cm2"),
     "pressure": ("[mass] / [length] / [time] ** 2", "Pa", "2MPa"),
     "force": ("[mass] * [length] / [time] ** 2", "N", "10N"),
+    "work of adhesion": ("[mass] / [time] ** 2", "J/m^2", "50mJ/m2"),
 }
 
 # A leading number, then the unit text: "4cm2" -> ("4", "cm2").
@@ -125,6 +126,14 @@ def parse_pressure(value: str | float, *, option: str = "pressure") -> float:
 def parse_force(value: str | float, *, option: str = "force") -> float:
     """A force > 0 in newtons."""
     return parse_quantity(value, "force", option=option)
+
+
+def parse_work_of_adhesion(value: str | float, *, option: str = "work of adhesion") -> float:
+    """A work of adhesion >= 0 in J/m^2 ('50mJ/m2', '0.05 N/m'; a plain number is J/m^2)."""
+    w = parse_quantity(value, "work of adhesion", option=option, positive=False)
+    if w < 0:
+        raise MetainterfaceError(f"{option} must be >= 0, got {value!r}", argument=option)
+    return w
 
 
 #: Force units named in messages about a force column's unit (pint reads any other too).

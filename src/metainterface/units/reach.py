@@ -36,21 +36,22 @@ import torch
 
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.sneddon import log_kc
-
-#: Shape exponents sampled across [gamma_min, gamma_max] for the bounds.
-GAMMA_SAMPLES = 129
-#: Forces sampled per asperity, 0 to the largest one asperity carries.
-FORCE_SAMPLES = 256
+from metainterface.units._convolution import FORCE_SAMPLES, GAMMA_SAMPLES, _convolve
 
 
 def alpha_bounds(
-    p_star: np.ndarray, settings: CellSettings | None = None
+    p_star: np.ndarray, settings: CellSettings | None = None, adhesion: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """(lo, hi, P*_reach): the contact fraction any cell of ``settings`` reaches at each
     pressure p_star (M,), and the largest pressure any reaches (lo = inf, hi = -inf beyond
-    it, and at P* <= 0)."""
+    it, and at P* <= 0). adhesion: w [E* R] (``physical.adhesive_reach``), 0 for none."""
     s = settings or CellSettings()
-    force, lo_n, hi_n = _envelope(s)
+    if adhesion:
+        from metainterface.units.adhesive_reach import adhesive_envelope
+
+        force, lo_n, hi_n = adhesive_envelope(s, float(adhesion))
+    else:
+        force, lo_n, hi_n = _envelope(s)
     p = np.asarray(p_star, dtype=np.float64)
     f = p * s.nominal_area
     reach = float(force[-1] / s.nominal_area)
@@ -87,16 +88,6 @@ def _envelope(s: CellSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         hi_n = _convolve(hi_n, high, np.maximum)
     force = np.arange(lo_n.size) * (f[1] - f[0])
     return force, lo_n, hi_n
-
-
-def _convolve(a: np.ndarray, b: np.ndarray, pick) -> np.ndarray:
-    """(a * b)[j] = pick over i of a[j - i] + b[i]: the min-plus (or max-plus) convolution."""
-    n = a.size + b.size - 1
-    fill = np.inf if pick is np.minimum else -np.inf
-    out = np.full(n, fill)
-    for i, v in enumerate(b):  # len(b) passes over a: ~FORCE_SAMPLES vector operations
-        out[i : i + a.size] = pick(out[i : i + a.size], a + v)
-    return out
 
 
 @dataclass(frozen=True, repr=False)
@@ -159,10 +150,12 @@ def reachability(
     area: float = 1.0,
     settings: CellSettings | None = None,
     units: bool = True,
+    adhesion: float = 0.0,
 ) -> Reachability:
     """Whether a friction law (K,) [N] is reachable at tau [Pa], E* [Pa] and a nominal area
     [m^2] by cells of ``settings``. With ``units=False`` the inputs are P* and alpha (and
-    tau = E* = A = 1): the same test on a dimensionless target."""
+    tau = E* = A = 1): the same test on a dimensionless target. adhesion: w / (E* R), for
+    cells of JKR asperities."""
     fn = np.asarray(normal_force, dtype=np.float64)
     ff = np.asarray(friction_force, dtype=np.float64)
     keep = fn > 0
@@ -171,16 +164,21 @@ def reachability(
     alpha = ff / (shear_strength * area)
     # the one reach test (feasible_scale and design ask it too); imported here because
     # metainterface.inverse imports this module
-    from metainterface.inverse.envelope import reach_violation, reachable_envelope
+    from metainterface.inverse.envelope import TOLERANCE, reach_violation, reachable_envelope
 
     cell = settings or CellSettings()
-    lo, hi, p_reach = reachable_envelope(p, cell)
+    if adhesion > 0:  # JKR cells: their exact bounds (the scale search takes no adhesion)
+        lo, hi, p_reach = alpha_bounds(p, settings, adhesion)
+        slack = TOLERANCE * alpha.max()
+        ok = (p <= p_reach) & (alpha >= lo - slack) & (alpha <= hi + slack)
+    else:
+        lo, hi, p_reach = reachable_envelope(p, cell)
+        ok = reach_violation(p, alpha, cell) == 0
     to_mu = shear_strength / e_star  # mu = (alpha / P*) tau / E*
     law_mu = ff / fn
     within = p <= p_reach
     f_reach = p_reach * area * e_star
     coverage = float(min(1.0, f_reach / fn.max()))
-    ok = reach_violation(p, alpha, cell) == 0
     reachable = bool(ok.all())
     if within.any():
         mu_lo, mu_hi = lo[within] / p[within] * to_mu, hi[within] / p[within] * to_mu

@@ -1,0 +1,73 @@
+"""Design with adhesion (issue 38, item 2): the shipped surrogate's zero-shot error on
+adhesive targets, and after the refinement with the adhesive model.
+
+Held-back cells (random gamma in [1.8, 4], heights in [0, 0.6] Delta_max, seeds 100..)
+give their loading curves under Independent(adhesion=w) (w = 4.2e-5 E* R: PDMS on glass
+at R = 0.5 mm) and, for comparison, without adhesion. Each target is designed with the
+surrogate alone (zero-shot: the surrogate does not read w; its proposals are scored with
+the adhesive model) and with the refinement. No BEM check (verify=False).
+
+    PYTHONPATH=src python benchmarks/bench_adhesive_design.py [--targets 8]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+import warnings
+
+import numpy as np
+import torch
+
+import metainterface as mi
+from metainterface.physics import CellSettings
+
+W = 4.2e-5
+
+
+def target(model, g, h, s, name):
+    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
+    with torch.no_grad():
+        p_max = float(model.sweep(gt, ht, s, n_delta=2049).p_star[0, -1])
+        p = np.linspace(0, p_max, 64)
+        p[0] = 1e-12 * p_max
+        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
+    p[0] = 0.0
+    return mi.Target(p_star=p, alpha=a, name=name)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--targets", type=int, default=8)
+    args = parser.parse_args()
+    s = CellSettings()
+    rows = {}
+    for label, model in (("adhesive", mi.Independent(adhesion=W)), ("plain", mi.Independent())):
+        for refine in (False, True):
+            errs, secs = [], []
+            for k in range(args.targets):
+                rng = np.random.default_rng(100 + k)
+                g = rng.uniform(1.8, 4.0, 9)
+                h = rng.uniform(0, 0.6, 9) * s.delta_max
+                h -= h.min()
+                t = target(model, g, h, s, f"{label}{k}")
+                start = time.perf_counter()
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    r = mi.design(
+                        t, model=model, verify=False, effort=mi.Effort(refine=refine, seed=0)
+                    )
+                secs.append(time.perf_counter() - start)
+                errs.append(r.error)
+            key = f"{label:8s} {'refined' if refine else 'zero-shot'}"
+            rows[key] = errs
+            e = np.array(errs)
+            print(
+                f"{key:20s} median {100 * np.median(e):.2f} %  max {100 * e.max():.2f} %  "
+                f"<=2 %: {int((e <= 0.02).sum())}/{e.size}  ({np.mean(secs):.1f} s each)",
+                flush=True,
+            )
+
+
+if __name__ == "__main__":
+    main()

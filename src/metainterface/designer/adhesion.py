@@ -1,0 +1,169 @@
+"""The forward model a design uses for adhesive targets (issue 38).
+
+Adhesion is a property of the forward model (``Independent(adhesion=w)``): a friction law
+converted with a work of adhesion (``Target.from_friction(work_of_adhesion=...)``) carries
+w / (E* R) in ``meta["friction"]["adhesion"]``, and the design step's model takes it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from typing import Any
+
+from metainterface.errors import MetainterfaceError
+from metainterface.physics.models import ForwardModel
+
+
+def target_adhesion(target: Any) -> float:
+    """w / (E* R) that a target was converted with (0: none or not a friction law)."""
+    meta = getattr(target, "meta", None) or {}
+    friction = meta.get("friction") if isinstance(meta, dict) else None
+    if not isinstance(friction, dict):
+        return 0.0
+    return float(friction.get("adhesion", 0.0) or 0.0)
+
+
+def given_adhesion(
+    work_of_adhesion: str | float | None, modulus: str | float | None, radius: str | float | None
+) -> float:
+    """w / (E* R) from ``design``'s work_of_adhesion ('50mJ/m2' or J/m^2) and its scale's
+    modulus and radius (both needed: w is dimensionless only against E* R); 0 if None."""
+    if work_of_adhesion is None:
+        return 0.0
+    from metainterface.units.quantities import (
+        parse_length,
+        parse_pressure,
+        parse_work_of_adhesion,
+    )
+
+    w = parse_work_of_adhesion(work_of_adhesion, option="work_of_adhesion")
+    if modulus is None or radius is None:
+        raise MetainterfaceError(
+            "work_of_adhesion needs the modulus and radius too (w / (E* R) sets the contact)",
+            argument="work_of_adhesion",
+        )
+    e_star = parse_pressure(modulus, option="modulus")
+    r = parse_length(radius, option="radius")
+    return w / (e_star * r)
+
+
+def model_for_targets(
+    model: ForwardModel, targets: Sequence[Any], adhesion: float = 0.0
+) -> ForwardModel:
+    """``model`` with the adhesion its targets were converted with (or ``adhesion``,
+    w / (E* R), given to ``design``).
+
+    Targets designed in one batch share one model: their adhesions must agree (or be 0).
+    A model given with an adhesion of its own keeps it; one that differs from a target's
+    is an error (the law would be designed for another contact).
+    """
+    values = {round(target_adhesion(t), 15) for t in targets} | {round(adhesion, 15)}
+    values -= {0.0}
+    if not values:
+        return model
+    if len(values) > 1:
+        raise MetainterfaceError(
+            "targets designed together must share one work of adhesion (relative to E* R), "
+            f"got {sorted(values)}; design them separately"
+        )
+    w = values.pop()
+    if model.adhesion:
+        if abs(model.adhesion - w) > 1e-9 * w:
+            raise MetainterfaceError(
+                f"the model's adhesion {model.adhesion:g} differs from the target's {w:g} "
+                "(work of adhesion / (E* R)); give one of them",
+                argument="model",
+            )
+        return model
+    if not dataclasses.is_dataclass(model) or "adhesion" not in {
+        f.name for f in dataclasses.fields(model)
+    }:
+        raise MetainterfaceError(
+            f"model {model.label!r} does not take adhesion; use 'independent' or 'interacting'",
+            argument="model",
+        )
+    return dataclasses.replace(model, adhesion=w)
+
+
+#: The work of adhesion a friction-law design without one is checked at [J/m^2]: typical of
+#: the elastomers these parts are moulded or printed in (PDMS, silicones, TPU) on glass or
+#: a polished counterface, 40-70 mJ/m^2 (issue 38, item 6).
+STATED_WORK_OF_ADHESION = 0.05
+
+
+def adhesion_notes(
+    result: Any, work_of_adhesion: float = STATED_WORK_OF_ADHESION
+) -> tuple[str, ...]:
+    """Notes on adhesion for a design of a friction law (none for other targets).
+
+    With adhesion: the cell's pull-off force over the interface (how sticky it feels).
+    Without: how much a work of adhesion ``work_of_adhesion`` [J/m^2] would change the
+    design's friction at the law's smallest and largest loads, and at zero load, so a
+    user who leaves adhesion out sees when that is unsafe.
+    """
+    import numpy as np
+    import torch
+
+    from metainterface.physics.adhesion import ADHESION_LIMIT
+
+    friction = (getattr(result.target, "meta", None) or {}).get("friction")
+    if not isinstance(friction, dict) or "e_star_pa" not in friction:
+        return ()
+    e_star, radius = float(friction["e_star_pa"]), float(friction["radius_m"])
+    tau, area = float(friction["shear_strength_pa"]), float(friction["area_m2"])
+    design, model = result.design, result.model
+    gamma, h = design.tensors(torch.float64)
+    s = design.settings
+    if model.adhesion:
+        p_off = model.design_pull_off(design)
+        return (
+            f"adhesion: pull-off force {p_off * e_star * area:.3g} N over the interface "
+            f"(P*_off = {p_off:.3g}, w = {friction.get('work_of_adhesion_j_m2', 0) * 1e3:.3g} "
+            "mJ/m^2)",
+        )
+    w = work_of_adhesion / (e_star * radius)
+    if not 0 < w <= ADHESION_LIMIT or not dataclasses.is_dataclass(model):
+        return ()
+    sticky = dataclasses.replace(model, adhesion=w)
+    p = np.asarray(result.target.p_star, dtype=np.float64)
+    p = p[p > 0]
+    if p.size == 0:
+        return ()
+    loads = torch.as_tensor(np.array([p[0], p[-1]]))[None]
+    try:
+        with torch.no_grad():
+            plain = model.alpha_at_loads(gamma, h, s, loads)[0].numpy()
+            adh = sticky.alpha_at_loads(gamma, h, s, loads)[0].numpy()
+            zero = sticky.alpha_at_loads(gamma, h, s, loads[:, :1] * 1e-9)[0, 0].item()
+    except MetainterfaceError:
+        return ()
+    change = adh / np.where(plain > 0, plain, np.inf) - 1
+    fn = np.array([p[0], p[-1]]) * e_star * area
+    return (
+        f"adhesion: at w = {work_of_adhesion * 1e3:.3g} mJ/m^2 (typical of elastomers on "
+        f"glass) this design's friction would be {100 * change[1]:+.3g} % at {fn[1]:.3g} N, "
+        f"{100 * change[0]:+.3g} % at {fn[0]:.3g} N and {zero * tau * area:.3g} N at zero "
+        "load; design with --work-of-adhesion if the part's interface adheres",
+    )
+
+
+def adhesive_bem_check(result: Any, checks: Any) -> Any:
+    """``result`` with the note of its check in the adhesive BEM (JKR limit, the grid of
+    ``checks``, a ``Verify``): adhesive designs are checked, not yet corrected."""
+    import dataclasses as dc
+
+    from metainterface._device import resolve_device
+    from metainterface.validation.adhesive_bem import check_adhesive
+
+    grid = checks.grid_for(result.design.settings)
+    device = resolve_device(checks.device)
+    check = check_adhesive(
+        result.design,
+        result.model,
+        result.target.p_star,
+        result.target.alpha,
+        grid=grid,
+        device=device,
+    )
+    return dc.replace(result, notes=(*result.notes, check.note()))

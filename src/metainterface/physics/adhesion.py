@@ -1,0 +1,481 @@
+"""Adhesive asperities: JKR contact of power-law punches, and the adhesive cell (issue 38).
+
+One asperity. Any axisymmetric adhesive contact in the JKR limit is the adhesionless
+(Sneddon) contact of radius a plus a flat punch of the same radius pulled back
+(Johnson 1985, sec. 5.5; Maugis 2000; Borodich, Galanov & Suarez-Alvarez 2014 for power
+laws). With kc = kappa(gamma) c (``sneddon.log_kc``), w the work of adhesion in units of
+E* R (w_phys = w E* R), lengths in units of R as everywhere in the core:
+
+    delta(a) = kc a^gamma - sqrt(2 pi w R a)                                   [length]
+    F(a) / E* = 2 gamma/(gamma + 1) kc a^(gamma + 1) - sqrt(8 pi w R a^3)      [length^2]
+
+(R appears because w is measured in E* R; with R = 1 it drops out.) Three radii mark the
+curve, each a power of the one at zero indentation a0 (kc a0^gamma = sqrt(2 pi w R a0)):
+the detachment under displacement control a_d = a0 (2 gamma)^(-1/(gamma - 1/2)), where
+d delta/da = 0, and the pull-off of one asperity under load control
+a_F = a0 (3 / (2 gamma))^(1/(gamma - 1/2)), where dF/da = 0. For gamma = 2 these are the
+classical JKR sphere (a0^3 = 2 pi w_phys R^2 / E*, pull-off force 3/2 pi w_phys R).
+
+The cell (rigid flat at approach Delta, asperity i compressed by x_i = Delta - h_i, or by
+Delta - h_i - sum_j K_ij F_j with the lattice's interaction, ``physics.interaction``).
+On each asperity's stable branch (a >= a_d) the contact radius is the largest root of
+delta(a) = x_i, found by Newton's method (delta(a) is convex there) and differentiated
+implicitly. Under a rising normal force (load control, the curve a user sees):
+
+* an asperity snaps in when it touches (x_i = 0, a jumps from 0 to a0), pulling the flat;
+* the flat follows the running maximum of the cell's force F(Delta): where F falls below
+  it (just after a snap-in) no equilibrium is near and the cell jumps forward to where F
+  regains it; alpha jumps there, at constant P*.
+
+Unloading from Delta_max (a falling force): every asperity that touched stays attached down
+to x_i = delta(a_d) (displacement-controlled detachment of that asperity), the flat follows
+the running minimum of F, and the cell comes off at the least force on that branch: the
+pull-off force, reported as a positive P*_off = -min F / (A_nom E*).
+
+All functions are pure and batched: leading batch axis B, N asperities, K Delta samples;
+no loops over samples or asperities (only over Newton steps).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import torch
+from torch import Tensor
+
+from metainterface.errors import MetainterfaceError
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.curves import Sweep, anchor, delta_grid
+from metainterface.physics.sneddon import log_kc
+
+#: Newton steps at most for a contact radius (they stop earlier once every step is below
+#: round-off); from the starts below, loading points converge in 4-6.
+NEWTON_STEPS = 60
+#: Jacobi sweeps of the interaction (outer iterations, each a full set of JKR solves).
+ITERATIONS = 4
+#: Golden-section steps that refine the cell's least force between two sweep samples.
+_GOLDEN_STEPS = 48
+#: Largest work of adhesion accepted, in units of E* R (a PDMS sphere of 1 um has ~0.02).
+ADHESION_LIMIT = 1.0
+
+
+def check_adhesion(w: object) -> float:
+    """The work of adhesion as a float in [0, ADHESION_LIMIT] [E* R], or a one-line error."""
+    if isinstance(w, bool | str) or w is None:
+        raise MetainterfaceError(
+            f"adhesion must be a number in [0, {ADHESION_LIMIT:g}] (E* R), got {w!r}",
+            argument="adhesion",
+        )
+    try:
+        value = float(w)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise MetainterfaceError(
+            f"adhesion must be a number in [0, {ADHESION_LIMIT:g}] (E* R), got {w!r}",
+            argument="adhesion",
+        ) from None
+    if not (math.isfinite(value) and 0.0 <= value <= ADHESION_LIMIT):
+        raise MetainterfaceError(
+            f"adhesion must be in [0, {ADHESION_LIMIT:g}] (work of adhesion / E* R), got {value:g}",
+            argument="adhesion",
+        )
+    return value
+
+
+# --- one asperity, elementwise (any broadcastable shapes) ------------------------------------
+
+
+def _kc(gamma: Tensor, radius: float) -> Tensor:
+    return torch.exp(log_kc(gamma, radius))
+
+
+def _root_2piwr(w: Tensor | float, radius: float) -> Tensor | float:
+    """sqrt(2 pi w R): the flat punch's coefficient, delta_flat = sqrt(2 pi w R a)."""
+    if isinstance(w, Tensor):
+        return torch.sqrt(2.0 * math.pi * radius * w)
+    return math.sqrt(2.0 * math.pi * radius * w)
+
+
+def jkr_indentation(gamma: Tensor, a: Tensor, w: Tensor | float, radius: float = 1.0) -> Tensor:
+    """delta(a) = kc a^gamma - sqrt(2 pi w R a) [length] at contact radius a >= 0 [length]."""
+    return _kc(gamma, radius) * a**gamma - _root_2piwr(w, radius) * torch.sqrt(a)
+
+
+def jkr_force(gamma: Tensor, a: Tensor, w: Tensor | float, radius: float = 1.0) -> Tensor:
+    """F / E* = 2 gamma/(gamma + 1) kc a^(gamma + 1) - sqrt(8 pi w R a^3) [length^2]."""
+    hertz = 2.0 * gamma / (gamma + 1.0) * _kc(gamma, radius) * a ** (gamma + 1.0)
+    return hertz - 2.0 * _root_2piwr(w, radius) * a * torch.sqrt(a)
+
+
+def touch_radius(gamma: Tensor, w: Tensor | float, radius: float = 1.0) -> Tensor:
+    """a0, the contact radius at zero indentation (snap-in at touch) [length]; 0 if w = 0."""
+    w = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
+    safe = torch.where(w > 0, w, torch.ones_like(w))
+    log_a0 = (0.5 * torch.log(2.0 * math.pi * radius * safe) - log_kc(gamma, radius)) / (
+        gamma - 0.5
+    )
+    return torch.where(w > 0, torch.exp(log_a0), torch.zeros_like(log_a0))
+
+
+def detach_radius(gamma: Tensor, w: Tensor | float, radius: float = 1.0) -> Tensor:
+    """a_d = a0 (2 gamma)^(-1/(gamma - 1/2)): where d delta/da = 0, the least radius of the
+    stable branch under displacement control [length]."""
+    return touch_radius(gamma, w, radius) * (2.0 * gamma) ** (-1.0 / (gamma - 0.5))
+
+
+def pull_off_radius(gamma: Tensor, w: Tensor | float, radius: float = 1.0) -> Tensor:
+    """a_F = a0 (3 / (2 gamma))^(1/(gamma - 1/2)): where dF/da = 0, the radius at which one
+    asperity comes off under load control [length]."""
+    return touch_radius(gamma, w, radius) * (1.5 / gamma) ** (1.0 / (gamma - 0.5))
+
+
+def jkr_radius(
+    gamma: Tensor,
+    x: Tensor,
+    w: Tensor | float,
+    radius: float = 1.0,
+    *,
+    self_coupling: Tensor | None = None,
+) -> Tensor:
+    """Contact radius a [length] on the stable branch (a >= a_d) of delta(a) = x [length].
+
+    Broadcasts over gamma, x, w. Where x < delta(a_d) there is no root: a_d is returned
+    (the caller masks those asperities as detached). Newton's method without a graph, from
+    a start right of a_d (delta is convex there, so after one step the iterates fall
+    monotonically onto the root), then one step with a graph: the implicit gradient
+    da/dtheta = -(d residual/dtheta) / (d residual/da), exact at the root.
+    self_coupling: k (broadcastable), solves delta(a) + k F(a) / E* = x instead (an
+    asperity's own images in the periodic lattice), |k| dF/da small against d delta/da.
+    """
+    w_t = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
+
+    def residual(a: Tensor, g: Tensor, xx: Tensor, ww: Tensor) -> tuple[Tensor, Tensor]:
+        kc = _kc(g, radius)
+        s = _root_2piwr(ww, radius)
+        root_a = torch.sqrt(a)
+        pa = kc * a**g
+        res = pa - s * root_a - xx
+        slope = g * pa / a - 0.5 * s / root_a
+        if self_coupling is not None:
+            f = 2.0 * g / (g + 1.0) * pa * a - 2.0 * s * a * root_a
+            df = 2.0 * g * pa - 3.0 * s * root_a
+            res = res + self_coupling * f
+            slope = slope + self_coupling * df
+        return res, slope
+
+    with torch.no_grad():
+        g0, x0, w0 = gamma.detach(), x.detach(), w_t.detach()
+        a_t = touch_radius(g0, w0, radius)
+        a_d = a_t * (2.0 * g0) ** (-1.0 / (g0 - 0.5))
+        kc = _kc(g0, radius)
+        s = _root_2piwr(w0, radius)
+        xp = torch.clamp_min(x0, 0.0)
+        # a >= a_lo = max(Hertz radius, a0) for x >= 0; two fixed-point steps
+        # a <- ((x + s sqrt(a)) / kc)^(1/gamma) from it stay below the root and near it
+        hertz = (xp / kc) ** (1.0 / g0)
+        a = torch.maximum(hertz, a_t)
+        for _ in range(2):
+            a = ((xp + s * torch.sqrt(a)) / kc) ** (1.0 / g0)
+        # for x < 0 the root lies in [a_d, a0): start at a0, right of it
+        a = torch.where(x0 >= 0, a, a_t)
+        a = torch.broadcast_to(a, torch.broadcast_shapes(a.shape, x0.shape, g0.shape)).clone()
+        floor = torch.broadcast_to(a_d, a.shape)
+        tiny = 4.0 * torch.finfo(a.dtype).eps
+        for _ in range(NEWTON_STEPS):
+            res, slope = residual(a, g0, x0, w0)
+            ok = slope > 0
+            step = torch.where(ok, res / torch.where(ok, slope, 1.0), 0.0)
+            a_new = torch.maximum(a - step, floor)
+            if bool(((a_new - a).abs() <= tiny * a).all()):
+                a = a_new
+                break
+            a = a_new
+    if not (gamma.requires_grad or x.requires_grad or w_t.requires_grad):
+        return a
+    res, slope = residual(a, gamma, x, w_t)
+    ok = slope.detach() > 0
+    return a - torch.where(ok, res / torch.where(ok, slope.detach(), 1.0), 0.0)
+
+
+# --- the cell ---------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class AdhesiveState:
+    """Each asperity of (B, N) designs at the approaches Delta (B or 1, K), layout (B, N, K).
+
+    radius: contact radius a [length] (0 out of contact); force: F / E* [length^2];
+    force_slope: dF_i/dDelta / E* [length], area_slope: d(pi a_i^2)/dDelta [length] (both
+    with the interaction's tangent where there is one; detached).
+    """
+
+    radius: Tensor
+    force: Tensor
+    force_slope: Tensor
+    area_slope: Tensor
+
+
+def adhesive_state(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    w: float,
+    delta: Tensor,
+    *,
+    unloading: bool = False,
+    kernel: Tensor | None = None,
+    iterations: int = ITERATIONS,
+) -> AdhesiveState:
+    """The JKR state of every asperity at the approaches ``delta`` (K,) or (B, K) [length].
+
+    gamma, h: (B, N), h anchored here (min h -> 0). w: work of adhesion [E* R].
+    Loading (default): asperity i is in contact where its compression x_i >= 0 (snap-in at
+    touch). ``unloading``: from Delta_max down; every asperity that touched by Delta_max
+    (h_i <= Delta_max) stays attached while x_i >= delta(a_d). kernel: the (N, N)
+    interaction matrix K [1/length] (``interaction(settings).shift``), None for independent
+    asperities; x_i = Delta - h_i - sum_j K_ij F_j / E*, by ``iterations`` Jacobi sweeps with
+    each asperity's own term K_ii taken implicitly.
+    """
+    radius = settings.radius
+    g = gamma[:, :, None]
+    hh = anchor(h)[:, :, None]
+    d = delta[None, None, :] if delta.dim() == 1 else delta[:, None, :]
+    gap0 = d - hh  # (B, N, K)
+    w_t = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
+    x_d = jkr_indentation(g, detach_radius(g, w_t, radius), w_t, radius)  # (B, N, 1), <= 0
+    reached = hh <= settings.delta_max * (1 + 1e-12)
+
+    def in_contact(x: Tensor) -> Tensor:
+        if unloading:
+            return reached & (x >= x_d)
+        return x >= 0
+
+    self_k = None
+    off = None
+    if kernel is not None:
+        k_diag = torch.diagonal(kernel)
+        self_k = k_diag[None, :, None]
+        off = kernel - torch.diag_embed(k_diag)
+    # The first pass solves the independent asperities; then Jacobi sweeps on
+    # x_i = gap0_i - sum_{j != i} K_ij F_j (previous sweep), K_ii F_i implicit. Started from
+    # the independent state, identical asperities (no relative shift) stay at it exactly.
+    x = gap0
+    force = torch.zeros_like(gap0)
+    sweeps = 1 + (iterations if kernel is not None else 0)
+    for sweep_no in range(sweeps):
+        coupled = off is not None and sweep_no > 0
+        if coupled:
+            x = gap0 - torch.einsum("ij,bjk->bik", off, force)
+        on = in_contact(x)
+        # loading: out of contact is x < 0, where no radius is needed; solving at x = 0
+        # instead spares the slow Newton steps near a cusp that nothing reads
+        xs = x if unloading else torch.clamp_min(x, 0.0)
+        raw = jkr_radius(g, xs, w_t, radius, self_coupling=self_k if coupled else None)
+        # masked with where, not a product: 0^gamma has no gradient in gamma
+        force = torch.where(on, jkr_force(g, raw, w_t, radius), 0.0)
+        a = torch.where(on, raw, 0.0)
+    # slopes along Delta, per asperity: dx/da and dF/da on the branch
+    with torch.no_grad():
+        kc = _kc(g, radius)
+        s = _root_2piwr(w_t, radius)
+        safe = torch.where(on, a, torch.ones_like(a))
+        pa = kc * safe**g
+        dx_da = g * pa / safe - 0.5 * s / torch.sqrt(safe)
+        df_da = 2.0 * g * pa - 3.0 * s * torch.sqrt(safe)
+        if self_k is not None:
+            dx_da = dx_da + self_k * df_da
+        good = on & (dx_da > 0)
+        inv = torch.where(good, 1.0 / torch.where(good, dx_da, 1.0), 0.0)
+        f_t, a_t = df_da * inv, 2.0 * math.pi * safe * inv
+        if off is not None:  # tangent t_i = dx_i/dDelta = 1 - sum_j K_ij dF_j/dDelta (Jacobi)
+            t = torch.ones_like(f_t)
+            for _ in range(iterations):
+                t = 1.0 - torch.einsum("ij,bjk->bik", off, f_t * t)
+            f_t, a_t = f_t * t, a_t * t
+        f_t, a_t = f_t * on, a_t * on
+    return AdhesiveState(radius=a, force=force, force_slope=f_t, area_slope=a_t)
+
+
+def sweep_adhesive(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    w: float,
+    *,
+    n_delta: int | None = None,
+    delta: Tensor | None = None,
+    kernel: Tensor | None = None,
+    iterations: int = ITERATIONS,
+) -> tuple[Sweep, Tensor]:
+    """The loading curve of (B, N) adhesive designs under a rising normal force.
+
+    delta: (K,) or (B, K) approaches [length] on [0, Delta_max] (default ``n_delta`` uniform
+    ones). Returns the Sweep (delta; P* (B, K) the running maximum of the cell's force,
+    floored at 0; alpha (B, K) the state the cell is in at that force: where the force is
+    below its running maximum, the state it jumps to; S* = dP*/dalpha there, 0 where P* is
+    flat; load_slope dP*/dDelta, 0 where flat, detached) and each asperity's contact area /
+    A_nom, (B, K, N). Differentiable in gamma and h (and through P*'s running maximum).
+    """
+    if delta is None:
+        delta = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
+    st = adhesive_state(gamma, h, settings, w, delta, kernel=kernel, iterations=iterations)
+    a_nom = settings.nominal_area
+    force = st.force.sum(1) / a_nom  # (B, K)
+    top = torch.cummax(torch.clamp_min(force, 0.0), dim=-1).values
+    k = force.shape[-1]
+    index = torch.arange(k, device=force.device).expand_as(force)
+    on_branch = force >= top
+    # the state the cell jumps to: the first sample at or after k back on the branch
+    marks = torch.where(on_branch, index, torch.full_like(index, k - 1))
+    jump = torch.flip(torch.cummin(torch.flip(marks, [-1]), dim=-1).values, [-1])
+    # ... between that sample and the one before it, where the force crosses the running
+    # maximum: the state is interpolated linearly in the force there (exact at the samples
+    # on the branch, second order in the step inside a jump)
+    before = (jump - 1).clamp_min(0)
+    f_j, f_b = force.gather(-1, jump), force.gather(-1, before)
+    span = f_j - f_b
+    weight = torch.where(
+        span > 0, ((top - f_b) / torch.where(span > 0, span, 1.0)).clamp(0, 1), 1.0
+    )
+    per = (math.pi / a_nom) * st.radius**2  # (B, N, K)
+    idx_j = jump[:, None, :].expand_as(per)
+    idx_b = before[:, None, :].expand_as(per)
+    per_b = per.gather(-1, idx_b)
+    per_j = (per_b + weight[:, None, :] * (per.gather(-1, idx_j) - per_b)).permute(0, 2, 1)
+    alpha = per_j.sum(-1)
+    f_slope = st.force_slope.sum(1) / a_nom
+    a_slope = st.area_slope.sum(1) / a_nom
+    slope_j = f_slope.gather(-1, jump)
+    area_j = a_slope.gather(-1, jump)
+    flat = ~on_branch
+    stiffness = torch.where(
+        (area_j > 0) & ~flat, slope_j / torch.where(area_j > 0, area_j, 1.0), 0.0
+    )
+    load_slope = torch.where(flat, 0.0, f_slope).detach()
+    return Sweep(
+        delta=delta, p_star=top, alpha=alpha, stiffness=stiffness, load_slope=load_slope
+    ), per_j
+
+
+def _unloading_grid(
+    gamma: Tensor, h: Tensor, settings: CellSettings, w: float, n_delta: int
+) -> Tensor:
+    """(B, K) approaches from Delta_max down to just below the last detachment."""
+    g = gamma
+    w_t = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
+    x_d = jkr_indentation(g, detach_radius(g, w_t, settings.radius), w_t, settings.radius)
+    hh = anchor(h)
+    reached = hh <= settings.delta_max * (1 + 1e-12)
+    low = torch.where(reached, hh + x_d, torch.full_like(hh, math.inf)).amin(-1)
+    low = low - 1e-3 * (settings.delta_max - low)
+    s = torch.linspace(0.0, 1.0, n_delta, dtype=gamma.dtype, device=gamma.device)
+    return settings.delta_max + (low[:, None] - settings.delta_max) * s[None]
+
+
+def unloading_adhesive(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    w: float,
+    *,
+    n_delta: int = 1025,
+    delta: Tensor | None = None,
+    kernel: Tensor | None = None,
+    iterations: int = ITERATIONS,
+) -> Sweep:
+    """The unloading curve from Delta_max under a falling normal force.
+
+    delta: (B, K) descending approaches [length] (default: ``n_delta`` from Delta_max to
+    below the last detachment). P* (B, K): the running minimum of the cell's force (the
+    flat follows it down; it may be negative, a pull); alpha (B, K) the contact fraction of
+    that state (of the sample itself: where the force is above its running minimum the
+    cell has jumped, see ``pull_off``). S* is left NaN.
+    """
+    with torch.no_grad():
+        if delta is None:
+            delta = _unloading_grid(gamma, h, settings, w, n_delta)
+    st = adhesive_state(
+        gamma, h, settings, w, delta, unloading=True, kernel=kernel, iterations=iterations
+    )
+    a_nom = settings.nominal_area
+    force = st.force.sum(1) / a_nom
+    low = torch.cummin(force, dim=-1).values
+    alpha = (math.pi / a_nom) * (st.radius**2).sum(1)
+    return Sweep(
+        delta=delta,
+        p_star=low,
+        alpha=alpha,
+        stiffness=torch.full_like(low, math.nan),
+        load_slope=(st.force_slope.sum(1) / a_nom).detach(),
+    )
+
+
+def pull_off(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    w: float,
+    *,
+    n_delta: int = 1025,
+    kernel: Tensor | None = None,
+    iterations: int = ITERATIONS,
+) -> Tensor:
+    """The cell's pull-off pressure P*_off = -min F / (A_nom E*) >= 0 (B,), after loading
+    to Delta_max: the largest pull the unloading branch holds under load control.
+
+    The least force is searched on an ``n_delta`` sweep, refined by golden section between
+    the samples beside it, and compared with the force just before each asperity's own
+    detachment (x_i = delta(a_d), where it is least on that asperity's part of the
+    branch). Differentiable in gamma and h at the minimising approach (the envelope
+    gradient where the minimum is a stationary point).
+    """
+
+    def force_at(dl: Tensor) -> Tensor:
+        st = adhesive_state(
+            gamma, h, settings, w, dl, unloading=True, kernel=kernel, iterations=iterations
+        )
+        return st.force.sum(1) / settings.nominal_area
+
+    with torch.no_grad():
+        grid = _unloading_grid(gamma, h, settings, w, n_delta)  # (B, K) descending
+        f = force_at(grid)
+        k = int(f.shape[-1])
+        i = f.argmin(-1, keepdim=True)
+        hi = grid.gather(-1, (i - 1).clamp_min(0))
+        lo = grid.gather(-1, (i + 1).clamp_max(k - 1))
+        best_d, best_f = grid.gather(-1, i), f.gather(-1, i)
+        ratio = (math.sqrt(5.0) - 1.0) / 2.0
+        x1 = hi - ratio * (hi - lo)
+        x2 = lo + ratio * (hi - lo)
+        f1, f2 = force_at(x1), force_at(x2)
+        for _ in range(_GOLDEN_STEPS):
+            left = f1 < f2  # x1 < x2: the minimum lies in [lo, x2], else in [x1, hi]
+            hi = torch.where(left, x2, hi)
+            lo = torch.where(left, lo, x1)
+            new_x = torch.where(left, hi - ratio * (hi - lo), lo + ratio * (hi - lo))
+            new_f = force_at(new_x)
+            x1, f1, x2, f2 = (
+                torch.where(left, new_x, x2),
+                torch.where(left, new_f, f2),
+                torch.where(left, x1, new_x),
+                torch.where(left, f1, new_f),
+            )
+            for xc, fc in ((x1, f1), (x2, f2)):
+                better = fc < best_f
+                best_d = torch.where(better, xc, best_d)
+                best_f = torch.where(better, fc, best_f)
+        # just before each reached asperity detaches: Delta = h_i + delta(a_d,i)
+        w_t = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
+        x_d = jkr_indentation(
+            gamma, detach_radius(gamma, w_t, settings.radius), w_t, settings.radius
+        )
+        nudge = 1e-12 * settings.delta_max  # on the attached side of the cusp
+        cusp = (anchor(h) + x_d + nudge).clamp_max(settings.delta_max)  # (B, N)
+        fc = force_at(cusp)
+        if kernel is None:  # exactly at the cusp the asperity is attached: the left limit
+            cand = torch.cat([best_d, cusp], dim=-1)
+            cand_f = torch.cat([best_f, fc], dim=-1)
+        else:  # with the interaction the cusp moves: the searched minimum only
+            cand, cand_f = best_d, best_f
+        where = cand.gather(-1, cand_f.argmin(-1, keepdim=True))
+    return -force_at(where)[:, 0]

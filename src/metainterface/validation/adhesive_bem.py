@@ -1,0 +1,425 @@
+"""Adhesive periodic contact with the boundary element method, in torch (issue 38).
+
+The same half-space as ``torch_bem`` (E* = 1, periodic, the Fourier kernel
+u_hat = 2 p_hat / (E* |q|) and its inverse p_hat = E* |q| u_hat / 2, zero mean mode), a
+rigid surface z (tips up) held at a prescribed mean gap g_bar (displacement control: an
+adhesive contact has unstable branches under load control, which a path of mean gaps
+follows). Gap g = u - z - c >= 0; the mean pressure P* is an output. Two adhesion laws:
+
+Maugis-Dugdale, a resolved range (Rey, Anciaux & Molinari, Comput. Mech. 60, 2017, 69-81).
+A cohesive zone pulls with sigma_0 = w / rho wherever 0 < g < rho, nothing beyond: the
+interface energy is phi(g) = -w (1 - g / rho) for g < rho, 0 beyond. The gap is the primal
+unknown: the total energy E(g) = 1/2 <u, K^-1 u> + sum phi(g), u = g + z, is minimised
+over g >= 0 at fixed mean gap by a projected conjugate gradient on the points out of
+contact, its gradient q = K^-1 u + phi'(g) (Polonsky & Keer's scheme with the roles of
+pressure and gap exchanged): a step, a projection onto g >= 0, points in contact whose
+gradient asks to open put back out, a rescaling to the mean gap. On the free points q is
+the constant -P* at convergence; the pressure is p = K^-1 u + P*. Where the range spans
+several grid points this is the Tabor-regime contact (JKR when rho is small against the
+contact, DMT when large): checked against Tamaas's ``MaugisAdhesionFunctional``.
+
+JKR, the range unresolved (Pohrt & Popov, Facta Univ. Mech. Eng. 13, 2015, 3-10). At a
+sharp (JKR) edge the tension is -K_I / sqrt(2 pi s) at distance s from it, with
+K_I = sqrt(2 E* w) when the energy released equals w. A grid of spacing dx cannot follow
+that; the stress of the edge element is instead c_e K_I / sqrt(dx), c_e a constant of
+the discretisation. The mesh-dependent criterion: a point in contact comes off where its
+tension exceeds sigma_c = c_e sqrt(2 E* w / dx), and a point comes into contact where the
+surfaces overlap, or, beside the contact, where the gap is below the opening of a critical
+crack one spacing behind its edge, c_g sqrt(2 E* w dx) / E* (so the edge sits where the
+energy released equals w on loading too: the reversible JKR branch that the forward model
+follows; a point that came off in a solve closes again only by overlap, so the updates
+cannot cycle). At each mean gap the bonded problem (g = 0 on the contact set C, p = 0
+off it) is linear and solved by conjugate gradients; C is updated by the two rules until
+it no longer changes. c_e (``EDGE_FACTOR``) is calibrated for this kernel on a flat punch
+(Kendall: detachment at F = sqrt(8 pi w E* a^3)), see ``edge_factor``; the JKR sphere is
+then an independent check.
+
+Everything is float64 and batched over a leading axis B of cells of one grid size and
+side (``heights`` (B, M, M)); no loops over grid points.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from metainterface.errors import MetainterfaceError
+from metainterface.validation.torch_bem import displacement, unit_kernel
+
+#: The edge-element factor c_e of the JKR (Pohrt-Popov) criterion for this kernel: the
+#: tension of the most loaded edge point of a bonded flat punch is c_e K_I / sqrt(dx)
+#: (``edge_factor`` measures it; tests/validation/test_adhesive_bem.py checks it).
+EDGE_FACTOR = 1.035
+#: The closing factor c_g: the gap beside the edge of a bonded flat punch is at least
+#: c_g K_I sqrt(dx) / E* (the nearest neighbours; 0.94-0.99 on grids 128-256). A point
+#: beside the contact whose gap is below c_g K_c sqrt(dx), K_c = sqrt(2 E* w), lies at an
+#: edge whose stress intensity is below the critical one: the crack closes there.
+CLOSING_FACTOR = 1.25
+#: Conjugate-gradient iterations at most per solve, and the relative residual aimed at.
+MAX_ITER = 5000
+TOLERANCE = 1e-10
+
+
+def inverse_kernel(m: int, side: float, device: torch.device) -> Tensor:
+    """(1, M, M // 2 + 1): p_hat / u_hat = pi |k| / L for a cell of side L, E* = 1; 0 at
+    k = 0 (a uniform displacement costs no pressure on the periodic half-space)."""
+    k = unit_kernel(m, device)
+    return torch.where(k > 0, 1.0 / torch.where(k > 0, k, 1.0), 0.0)[None] / float(side)
+
+
+def forward_kernel(m: int, side: float, device: torch.device) -> Tensor:
+    """(1, M, M // 2 + 1): u_hat / p_hat = L / (pi |k|), 0 at k = 0 (``torch_bem``)."""
+    return unit_kernel(m, device)[None] * float(side)
+
+
+def _mean(x: Tensor, mask: Tensor) -> Tensor:
+    """(B, 1, 1) mean of x over the mask (float 0/1), 0 where the mask is empty."""
+    n = mask.sum(dim=(1, 2), keepdim=True)
+    return (x * mask).sum(dim=(1, 2), keepdim=True) / n.clamp_min(1.0)
+
+
+def _dot(a: Tensor, b: Tensor) -> Tensor:
+    return (a * b).sum(dim=(1, 2), keepdim=True)
+
+
+@dataclass(frozen=True)
+class AdhesiveSolution:
+    """Contacts of B cells at one mean gap each.
+
+    pressure, gap: (B, M, M) [E*; length]; contact: (B, M, M) bool (g = 0);
+    p_star: (B,) mean pressure P* (negative: the cell pulls); alpha: (B,) contact fraction;
+    residual: (B,) the solver's relative residual; iterations: conjugate-gradient steps.
+    """
+
+    pressure: Tensor
+    gap: Tensor
+    contact: Tensor
+    p_star: Tensor
+    alpha: Tensor
+    residual: Tensor
+    iterations: int
+
+
+def solve_maugis(
+    heights: Tensor,
+    side: float,
+    mean_gap: Tensor,
+    work: float,
+    rho: float,
+    *,
+    gap: Tensor | None = None,
+    tolerance: float = TOLERANCE,
+    max_iter: int = MAX_ITER,
+) -> AdhesiveSolution:
+    """Maugis-Dugdale contact of (B, M, M) surfaces at mean gaps (B,) [length].
+
+    work: w [E* length], rho: the range [length] (sigma_0 = w / rho). gap: (B, M, M) start
+    (the previous solution of a path), or None: the rigid gap rescaled to the mean gap.
+    Raises MetainterfaceError when the residual stays above ``tolerance``.
+    """
+    if not (work >= 0 and rho > 0):
+        raise MetainterfaceError(f"work must be >= 0 and rho > 0, got {work:g}, {rho:g}")
+    b, m, _ = heights.shape
+    inv = inverse_kernel(m, side, heights.device)
+    z = heights
+    target = mean_gap.reshape(b, 1, 1).to(z)
+    sigma0 = work / rho
+    g = z.amax(dim=(1, 2), keepdim=True) - z if gap is None else gap.clone()
+    g = g * (target / g.mean(dim=(1, 2), keepdim=True).clamp_min(1e-300))
+    t = torch.zeros_like(g)
+    g_old = torch.ones_like(target)
+    conj = torch.zeros_like(target, dtype=torch.bool)
+    cohesive_old = None
+    err = torch.full((b,), math.inf, dtype=z.dtype, device=z.device)
+    it = 0
+    for it in range(1, max_iter + 1):
+        pt = displacement(g + z, inv)
+        cohesive = (g < rho).to(z.dtype)
+        q = pt + sigma0 * cohesive
+        free = (g > 0).to(z.dtype)
+        q = q - _mean(q, free)
+        qf = q * free
+        big = _dot(qf, qf)
+        err = (big.sqrt() / _dot(pt, pt).sqrt().clamp_min(1e-300)).reshape(-1)
+        if bool((err <= tolerance).all()) and it > 1:
+            break
+        # a change of the cohesive set changes the energy's gradient by a jump: no
+        # conjugacy across it (nor across a change of the free set, below)
+        if cohesive_old is not None:
+            conj = conj & (cohesive == cohesive_old).all(dim=(1, 2), keepdim=True)
+        cohesive_old = cohesive
+        beta = torch.where(conj, big / g_old, 0.0)
+        t = qf + beta * t * free
+        g_old = big
+        r = displacement(t, inv)
+        r = r - _mean(r, free)
+        tau = _dot(qf, t) / _dot(r * free, t).clamp_min(1e-300)
+        g = torch.clamp_min(g - tau * t, 0.0)
+        # points in contact whose gradient asks them to open (q < 0): out again
+        opening = (g <= 0) & (q < 0)
+        g = torch.where(opening, -tau * q, g)
+        conj = ~opening.any(dim=(1, 2), keepdim=True)
+        g = g * (target / g.mean(dim=(1, 2), keepdim=True).clamp_min(1e-300))
+    if not bool((err <= tolerance).all()):
+        raise MetainterfaceError(
+            f"adhesive BEM (Maugis-Dugdale) did not converge: residual {float(err.max()):.3g} "
+            f"> tolerance {tolerance:g} after {max_iter} iterations"
+        )
+    pt = displacement(g + z, inv)
+    free = (g > 0).to(z.dtype)
+    cohesive = (g < rho).to(z.dtype)
+    p_star = -_mean(pt + sigma0 * cohesive, free)
+    pressure = pt + p_star
+    contact = g <= 0
+    alpha = contact.to(z.dtype).mean(dim=(1, 2))
+    return AdhesiveSolution(pressure, g, contact, p_star.reshape(-1), alpha, err, it)
+
+
+def _bonded(
+    z: Tensor, c: Tensor, contact: Tensor, fwd: Tensor, p0: Tensor, tolerance: float, max_iter: int
+) -> tuple[Tensor, Tensor]:
+    """Pressures on the contact sets (B, M, M) bool with g = u - z - c = 0 there, p = 0 off
+    them: conjugate gradients on K_CC p_C = (z + c)_C, from p0. Returns p and the residual."""
+    mask = contact.to(z.dtype)
+    rhs = (z + c) * mask
+    p = p0 * mask
+    r = rhs - displacement(p, fwd) * mask
+    d = r.clone()
+    rr = _dot(r, r)
+    scale = _dot(rhs, rhs).sqrt().clamp_min(1e-300)
+    for _ in range(max_iter):
+        if bool((rr.sqrt() <= tolerance * scale).all()):
+            break
+        ad = displacement(d, fwd) * mask
+        step = rr / _dot(d, ad).clamp_min(1e-300)
+        p = p + step * d
+        r = r - step * ad
+        rr_new = _dot(r, r)
+        d = r + (rr_new / rr.clamp_min(1e-300)) * d
+        rr = rr_new
+    return p, (rr.sqrt() / scale).reshape(-1)
+
+
+def _neighbours(mask: Tensor) -> Tensor:
+    """(B, M, M) bool: the points with a (periodic) 4-neighbour in ``mask``."""
+    out = torch.zeros_like(mask)
+    for dim in (1, 2):
+        for shift in (1, -1):
+            out = out | torch.roll(mask, shift, dims=dim)
+    return out
+
+
+def critical_tension(work: float, spacing: float, edge: float | None = None) -> float:
+    """sigma_c = c_e sqrt(2 E* w / dx) [E*]: the tension at which a bonded edge point comes
+    off on a grid of spacing dx (Pohrt & Popov 2015), E* = 1, w [E* length]."""
+    return (EDGE_FACTOR if edge is None else edge) * math.sqrt(2.0 * work / spacing)
+
+
+def solve_jkr(
+    heights: Tensor,
+    side: float,
+    mean_gap: Tensor,
+    work: float,
+    *,
+    contact: Tensor | None = None,
+    pressure: Tensor | None = None,
+    tolerance: float = TOLERANCE,
+    max_iter: int = MAX_ITER,
+    max_updates: int = 500,
+    edge: float | None = None,
+) -> AdhesiveSolution:
+    """JKR-limit contact of (B, M, M) surfaces at mean gaps (B,) (Pohrt-Popov criterion).
+
+    contact, pressure: the previous state of a path (hysteresis: a point that touched stays
+    bonded until its tension exceeds sigma_c), or None: start from the rigid overlap.
+    """
+    b, m, _ = heights.shape
+    fwd = forward_kernel(m, side, heights.device)
+    z = heights
+    spacing = side / m
+    sigma_c = critical_tension(work, spacing, edge)
+    # mean gap = mean(u - z - c), mean u = 0: c follows from the mean gap
+    c = -z.mean(dim=(1, 2), keepdim=True) - mean_gap.reshape(b, 1, 1).to(z)
+    if contact is None:
+        contact = (-z - c) <= 0
+    g_close = CLOSING_FACTOR * math.sqrt(2.0 * work * spacing)
+    p = torch.zeros_like(z) if pressure is None else pressure
+    res = torch.zeros(b, dtype=z.dtype, device=z.device)
+    came_off = torch.zeros_like(contact)
+    for _ in range(max_updates):
+        p, res = _bonded(z, c, contact, fwd, p, tolerance, max_iter)
+        g = displacement(p, fwd) - z - c
+        beside = _neighbours(contact) & ~contact
+        attach = ~contact & ((g < 0) | (beside & ~came_off & (g < g_close)))
+        detach = contact & (p < -sigma_c)
+        if not bool((attach | detach).any()):
+            break
+        came_off = came_off | detach
+        contact = (contact | attach) & ~detach
+    else:
+        raise MetainterfaceError(
+            f"adhesive BEM (JKR) found no stable contact set in {max_updates} updates"
+        )
+    g = (displacement(p, fwd) - z - c) * ~contact
+    p_star = p.mean(dim=(1, 2))
+    alpha = contact.to(z.dtype).mean(dim=(1, 2))
+    return AdhesiveSolution(p, g, contact, p_star, alpha, res, 0)
+
+
+def edge_factor(grid: int = 256, radius_cells: float = 0.125) -> float:
+    """Measure c_e: a bonded flat punch of radius a = radius_cells L on a grid of M points,
+    its most tensile edge point against K_I = F / (2 sqrt(pi a^3)) (Kendall), a from the
+    punch's pixel count. Returns max |p_edge| sqrt(dx) / K_I."""
+    side = 1.0
+    dx = side / grid
+    x = (np.arange(grid) - grid / 2) * dx
+    r = np.hypot(*np.meshgrid(x, x, indexing="ij"))
+    disc = r < radius_cells * side
+    heights = torch.as_tensor(np.where(disc, 0.0, -1.0))[None]
+    contact = torch.as_tensor(disc)[None]
+    fwd = forward_kernel(grid, side, torch.device("cpu"))
+    c = torch.full((1, 1, 1), -1e-3, dtype=torch.float64)  # a pull of 1e-3 L
+    p, _ = _bonded(heights, c, contact, fwd, torch.zeros_like(heights), 1e-12, 10000)
+    force = float(p.sum()) * dx * dx
+    a = math.sqrt(disc.sum() * dx * dx / math.pi)
+    k_i = abs(force) / (2.0 * math.sqrt(math.pi * a**3))
+    return float(p.abs().amax()) * math.sqrt(dx) / k_i
+
+
+@dataclass(frozen=True)
+class AdhesivePath:
+    """A cell loaded by approach (displacement control) in the JKR limit, then unloaded.
+
+    approach: (K,) the approach of the rigid plane [length, units of R] (0: the mean gap
+    of the surface's own tips-down plane); p_star, alpha: (K,) the BEM's mean pressure and
+    contact fraction there; loading: (K,) bool, the samples of the rising part; on_branch:
+    (K,) bool, the loading samples a rising force reaches (force at its running maximum
+    and > 0: the states of the load-controlled curve the forward model gives).
+    """
+
+    approach: np.ndarray
+    p_star: np.ndarray
+    alpha: np.ndarray
+    loading: np.ndarray
+    on_branch: np.ndarray
+
+
+def jkr_path(
+    heights: np.ndarray,
+    side: float,
+    work: float,
+    approaches: np.ndarray,
+    *,
+    unload: np.ndarray | None = None,
+    device: torch.device | str = "cpu",
+) -> AdhesivePath:
+    """One cell (M, M) along rising ``approaches`` (K,) [length], then falling ``unload``
+    ones, each state warm-started from the one before (the contact's history matters)."""
+    z = torch.as_tensor(np.ascontiguousarray(heights, dtype=np.float64), device=device)[None]
+    z_bar = -float(z.mean())
+    up = np.asarray(approaches, dtype=np.float64)
+    down = np.zeros(0) if unload is None else np.asarray(unload, dtype=np.float64)
+    contact = pressure = None
+    p_star, alpha = [], []
+    for d in np.concatenate([up, down]):
+        target = torch.tensor([z_bar - d], dtype=torch.float64, device=z.device)
+        sol = solve_jkr(z, side, target, work, contact=contact, pressure=pressure)
+        contact, pressure = sol.contact, sol.pressure
+        p_star.append(float(sol.p_star[0]))
+        alpha.append(float(sol.alpha[0]))
+    p = np.array(p_star)
+    loading = np.arange(p.size) < up.size
+    top = np.maximum.accumulate(np.where(loading, p, -np.inf))
+    on_branch = loading & (p >= top) & (p > 0)
+    return AdhesivePath(np.concatenate([up, down]), p, np.array(alpha), loading, on_branch)
+
+
+@dataclass(frozen=True)
+class AdhesiveCheck:
+    """An adhesive design against the JKR-limit BEM at the loads a rising force reaches.
+
+    p_star: (K,) the BEM's load-controlled states' P*; alpha_bem, alpha_model,
+    alpha_target: (K,) there (target interpolated, NaN beyond its range); error: relative
+    L2 of BEM against target over the target's range; model_error: the model against the
+    BEM; grid: M; seconds: the BEM's wall time.
+    """
+
+    p_star: np.ndarray
+    alpha_bem: np.ndarray
+    alpha_model: np.ndarray
+    alpha_target: np.ndarray
+    error: float
+    model_error: float
+    grid: int
+    seconds: float
+
+    def note(self) -> str:
+        """One line for a design's notes."""
+        return (
+            f"adhesive BEM (JKR limit, {self.grid}^2, {self.p_star.size} loads): error to the "
+            f"target {100 * self.error:.3g} %, model against BEM {100 * self.model_error:.3g} %"
+        )
+
+
+def check_adhesive(
+    design: Any,
+    model: Any,
+    target_p: np.ndarray,
+    target_alpha: np.ndarray,
+    *,
+    grid: int,
+    approaches: int = 16,
+    device: torch.device | str = "cpu",
+) -> AdhesiveCheck:
+    """Load ``design`` (a physics.Design) by approach to Delta_max in the JKR-limit BEM with
+    the work of adhesion of ``model`` (a ForwardModel with adhesion > 0), keep the states
+    a rising force reaches, and compare them with the target (P* (T,), alpha (T,)) and the
+    model at the same P*."""
+    import time
+
+    from metainterface.validation.heightmap import height_map
+
+    if not model.adhesion:
+        raise MetainterfaceError("check_adhesive needs a model with adhesion > 0")
+    s = design.settings
+    hm = height_map(design, grid)
+    start = time.perf_counter()
+    work = model.adhesion * s.e_star * s.radius  # w [E* length] in the cell's units
+    path = jkr_path(
+        hm.heights,
+        hm.cell_side,
+        work,
+        np.linspace(0.0, s.delta_max, approaches + 1)[1:],
+        device=device,
+    )
+    seconds = time.perf_counter() - start
+    p = path.p_star[path.on_branch]
+    bem = path.alpha[path.on_branch]
+    gamma, h = design.tensors(torch.float64)
+    with torch.no_grad():
+        mod = model.alpha_at_loads(gamma, h, s, torch.as_tensor(p)[None])[0].numpy()
+    tp = np.asarray(target_p, dtype=np.float64)
+    ta = np.interp(p, tp, np.asarray(target_alpha, dtype=np.float64))
+    inside = p <= tp[-1]
+    ta = np.where(inside, ta, np.nan)
+
+    def rel(a: np.ndarray, b: np.ndarray) -> float:
+        if not a.size:
+            return math.nan
+        return float(np.linalg.norm(a - b) / np.linalg.norm(b))
+
+    return AdhesiveCheck(
+        p_star=p,
+        alpha_bem=bem,
+        alpha_model=mod,
+        alpha_target=ta,
+        error=rel(bem[inside], ta[inside]),
+        model_error=rel(mod, bem),
+        grid=int(grid),
+        seconds=seconds,
+    )
