@@ -1,8 +1,9 @@
 """One design on one core: the paper's pipeline and the default design (issue 36).
 
 Budgets (in-process, one core, import and the first call excluded): the paper's pipeline,
-``mi.design(t, hedge=0, fallback=0, verify=False)``, <= 0.3 s per built-in target; the
-default design, ``mi.design(t, verify=False)`` (hedges, fallback), <= 2x that.
+``mi.design(t, effort=mi.Effort(hedge=0, fallback=0), verify=False)``, <= 0.3 s per
+built-in target; the default design, ``mi.design(t, verify=False)`` (hedges, fallback),
+<= 2x that.
 
 Prints per built-in target the median over --repeats of each, their ratio, and the errors;
 then the errors of both on the --batch realisable random-cell targets of bench_design.py
@@ -32,7 +33,7 @@ from bench_design import realisable_targets
 torch.set_num_threads(1)  # one core, before any design runs
 
 KINDS = {
-    "paper": dict(hedge=0, fallback=0, verify=False),
+    "paper": dict(effort=mi.Effort(hedge=0, fallback=0), verify=False),
     "default": dict(verify=False),
 }
 

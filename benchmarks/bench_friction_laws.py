@@ -5,7 +5,7 @@ power laws, bilinear), each turned into an alpha(P*) target at the scale that ma
 reachable (``mi.feasible_scale``: the middle of the widest feasible area range, else of the
 modulus range, else the closest scale), 40 rows each, no stiffness column: what a user's
 ``--friction-csv`` gives. Reported: the zero-shot relative curve error of the surrogate
-(``design(refine=False, hedge=0, fallback=0)``) per family, and, as the reference the
+(``design(effort=Effort(refine=False, hedge=0, fallback=0))``) per family, and, as the reference the
 network was trained for, the same on --cells exact curves of random cells given with their
 stiffness and without it. Optionally the refined error (``--refine``, the CLI's defaults).
 The same 50 laws are also given as measured: 8 random rows of the 40 with a 3 % scatter in

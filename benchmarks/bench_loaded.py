@@ -54,8 +54,8 @@ IN_PROCESS = {
     "design": "t = mi.Target.builtin('bilinear')\nmi.design(t, verify=False)\n"
     "t0 = time.perf_counter(); mi.design(t, verify=False)\n",
     "paper pipeline": "t = mi.Target.builtin('bilinear')\n"
-    "mi.design(t, verify=False, hedge=0, fallback=0)\n"
-    "t0 = time.perf_counter(); mi.design(t, verify=False, hedge=0, fallback=0)\n",
+    "mi.design(t, verify=False, effort=mi.Effort(hedge=0, fallback=0))\n"
+    "t0 = time.perf_counter(); mi.design(t, verify=False, effort=mi.Effort(hedge=0, fallback=0))\n",
     "validate": "d = mi.Design.load(sys.argv[1])\nmi.validate(d, grid=96, loads=2)\n"
     "t0 = time.perf_counter(); mi.validate(d, grid=384, loads=6)\n",
 }
