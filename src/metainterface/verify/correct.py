@@ -159,6 +159,9 @@ def fresh_design(
         extra_loss=extra_loss,
         model=model,
         hedge=RESTART_HEDGE,
+        # a shifted curve is rarely met within Effort.hedge_error by the prediction alone:
+        # its hedges are refined with it in one batch, not in a second pass after it
+        hedge_error=0.0,
     )[0]
     return Design(gamma=np.asarray(r.gamma).copy(), h=np.asarray(r.h).copy(), settings=settings)
 
