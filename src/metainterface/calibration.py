@@ -192,7 +192,7 @@ def calibrate_csv(
 ) -> Calibration:
     """:func:`calibrate_sphere` on a friction CSV (``normal_force,friction_force`` [N], or
     ``normal_force,friction_coefficient``; units in the header), quantities with units."""
-    from metainterface.units.friction import read_friction_csv
+    from metainterface.units.law_file import read_friction_csv
     from metainterface.units.quantities import parse_length, parse_pressure
 
     r = parse_length(sphere_radius, option="--sphere-radius")

@@ -15,16 +15,16 @@ from scipy import integrate, optimize
 
 import metainterface as mi
 from metainterface.errors import MetainterfaceError
-from metainterface.physics.adhesion import (
+from metainterface.physics.adhesion import sweep_adhesive
+from metainterface.physics.cell import CellSettings
+from metainterface.physics.jkr import (
     detach_radius,
     jkr_force,
     jkr_indentation,
     jkr_radius,
     pull_off_radius,
-    sweep_adhesive,
     touch_radius,
 )
-from metainterface.physics.cell import CellSettings
 
 F64 = torch.float64
 W = 4.2e-5  # PDMS on glass at R = 0.5 mm: 50 mJ/m^2 / (2.4 MPa * 0.5 mm)

@@ -105,7 +105,7 @@ def adhesion_notes(
     import numpy as np
     import torch
 
-    from metainterface.physics.adhesion import ADHESION_LIMIT
+    from metainterface.physics.jkr import ADHESION_LIMIT
 
     friction = (getattr(result.target, "meta", None) or {}).get("friction")
     if not isinstance(friction, dict) or "e_star_pa" not in friction:

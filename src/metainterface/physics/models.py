@@ -38,6 +38,7 @@ from metainterface.physics.interaction import (
     load_area_interacting,
     sweep_interacting,
 )
+from metainterface.physics.jkr import check_adhesion
 from metainterface.physics.metrics import interp
 from metainterface.physics.sneddon import area
 
@@ -302,7 +303,7 @@ class Independent(ForwardModel):
     placed = False
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "adhesion", jkr.check_adhesion(self.adhesion))
+        object.__setattr__(self, "adhesion", check_adhesion(self.adhesion))
 
     def sweep(self, gamma, h, settings, *, smooth=None, n_delta=None, delta=None) -> Sweep:
         if self.adhesion:
@@ -343,7 +344,7 @@ class Interacting(ForwardModel):
             raise MetainterfaceError(
                 f"iterations must be a whole number in [1, 100], got {self.iterations!r}"
             )
-        object.__setattr__(self, "adhesion", jkr.check_adhesion(self.adhesion))
+        object.__setattr__(self, "adhesion", check_adhesion(self.adhesion))
         if self.adhesion and self.curvature:
             raise MetainterfaceError(
                 "curvature must be False with adhesion (the adhesive interaction is the tip "

@@ -1,7 +1,8 @@
 """Physical units at the edges of the scale-free core.
 
 Quantities parsed with pint (``quantities``), a friction law in newtons turned into an alpha(P*)
-target and back (``friction``, Bowden-Tabor), and the dimensions of a design in SI for a
+target and back (``friction``, Bowden-Tabor; the law's file and its checks in
+``law_file``), and the dimensions of a design in SI for a
 given asperity radius and modulus (``dimensions``).
 """
 
@@ -13,8 +14,8 @@ from metainterface.units.friction import (
     friction_target,
     friction_target_from_options,
     friction_to_alpha,
-    read_friction_csv,
 )
+from metainterface.units.law_file import read_friction_csv
 from metainterface.units.quantities import (
     parse_area,
     parse_force,

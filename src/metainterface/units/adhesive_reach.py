@@ -16,8 +16,8 @@ import math
 import numpy as np
 import torch
 
-from metainterface.physics.adhesion import jkr_force, jkr_radius, touch_radius
 from metainterface.physics.cell import CellSettings
+from metainterface.physics.jkr import jkr_force, jkr_radius, touch_radius
 from metainterface.units._convolution import FORCE_SAMPLES, GAMMA_SAMPLES, _convolve
 
 #: Contact radii sampled per gamma along the loading branch, a0 to a(Delta_max).
