@@ -18,9 +18,10 @@ import time
 import numpy as np
 
 import metainterface as mi
+from metainterface.inverse.verdict import law_reachability as reachability
 from metainterface.physics import CellSettings
 from metainterface.scaling.search import violation
-from metainterface.units.reach import alpha_bounds, reachability
+from metainterface.units.reach import alpha_bounds
 
 
 def laws(count: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:

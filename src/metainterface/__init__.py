@@ -110,7 +110,7 @@ _HOMES: dict[str, str] = {
     "UnreachableError": "metainterface.errors",
     "UnitSlipWarning": "metainterface.errors",
     "ReachWarning": "metainterface.errors",
-    "Reachability": "metainterface.units.reach",
+    "Reachability": "metainterface.inverse.verdict",
     "reachability": "metainterface.inverse.verdict",
     "Target": "metainterface.inverse.targets",
     "CellSettings": "metainterface.physics.cell",
@@ -147,7 +147,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         UnreachableError,
     )
     from metainterface.inverse.targets import Target
-    from metainterface.inverse.verdict import reachability
+    from metainterface.inverse.verdict import Reachability, reachability
     from metainterface.manufacture.sizing import PrinterSizing, min_radius
     from metainterface.manufacture.tolerance import ToleranceResult, tolerance
     from metainterface.measure.result import MeasureResult
@@ -168,7 +168,6 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.surrogate.config import TrainConfig
     from metainterface.sweep.folders import validate, write_result
     from metainterface.sweep.many import validate_many
-    from metainterface.units.reach import Reachability
     from metainterface.validation.result import ValidationResult
     from metainterface.verify.check import BemCheck, Verify
 

@@ -10,8 +10,9 @@ import torch
 
 import metainterface as mi
 from metainterface.cli import main
+from metainterface.inverse.verdict import law_reachability as reachability
 from metainterface.physics.curves import sweep
-from metainterface.units.reach import alpha_bounds, reachability
+from metainterface.units.reach import alpha_bounds
 
 UNITS = dict(shear_strength="0.25MPa", modulus="2MPa", area="4cm2", radius="0.5mm")
 FN = np.linspace(0.25, 6.0, 24)
