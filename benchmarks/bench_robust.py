@@ -22,7 +22,7 @@ import torch
 
 import metainterface as mi
 from metainterface.inverse.perturb import Perturbation
-from metainterface.manufacture.scatter import spread
+from metainterface.inverse.scatter import spread
 from metainterface.runtime import tune_allocator
 
 sys.path.insert(0, str(Path(__file__).parent))

@@ -62,7 +62,7 @@ def _robust_stats(
 ) -> DesignResult:
     """The result with ``robust``: its nominal error and the distribution of the error of
     made cells (independent draws), beside the rms error it was refined against."""
-    from metainterface.manufacture.scatter import spread
+    from metainterface.inverse.scatter import spread
 
     d = r.design
     check = Perturbation.draw(

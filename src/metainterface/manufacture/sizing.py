@@ -14,9 +14,9 @@ from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._threads import uses_threads
 from metainterface.designer.results import DesignResult
+from metainterface.inverse import scatter as tol
 from metainterface.inverse.perturb import Perturbation
 from metainterface.inverse.targets import Target
-from metainterface.manufacture import scatter as tol
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
 from metainterface.units.quantities import parse_quantity

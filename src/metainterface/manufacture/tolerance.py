@@ -24,9 +24,9 @@ from metainterface._threads import uses_threads
 from metainterface.designer.curve_result import ReachCounts, shown
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
+from metainterface.inverse import scatter as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
 from metainterface.inverse.targets import Target
-from metainterface.manufacture import scatter as tol
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, get_model
 from metainterface.units.plausible import warn_unit_slips

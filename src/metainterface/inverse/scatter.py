@@ -1,4 +1,4 @@
-"""Manufacturing errors: perturbed copies of designs, their curves and errors in one batch.
+"""The spread of made cells' errors: perturbed copies of designs, their curves and errors.
 
 A made cell differs from its design: every asperity's height offset and shape exponent
 carry independent Gaussian errors, and the relief as a whole may be scaled (a z-axis
