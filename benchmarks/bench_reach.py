@@ -18,23 +18,10 @@ import time
 import numpy as np
 
 import metainterface as mi
+from metainterface._testing import borderline_laws
 from metainterface.inverse.verdict import law_reachability as reachability
 from metainterface.physics import CellSettings
 from metainterface.scaling.search import violation
-from metainterface.units.reach import alpha_bounds
-
-
-def laws(count: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    rng = np.random.default_rng(seed)
-    _, _, reach = alpha_bounds(np.array([1e-3]))
-    out = []
-    for _ in range(count):
-        p_max = reach * rng.uniform(0.05, 1.0)
-        p = np.linspace(p_max / 25, p_max, 20)
-        lo, hi, _ = alpha_bounds(p)
-        top = lo[-1] + rng.uniform(-0.2, 1.2) * (hi[-1] - lo[-1])
-        out.append((p, top * (p / p_max) ** rng.uniform(0.3, 1.2)))
-    return out
 
 
 def main() -> None:
@@ -44,7 +31,7 @@ def main() -> None:
     args = ap.parse_args()
     s = CellSettings()
     t0 = time.perf_counter()
-    pairs = laws(args.laws, seed=0)
+    pairs = borderline_laws(args.laws, points=20, smallest=0.05, seed=0)
     a = np.array([reachability(p, al, settings=s, units=False).reachable for p, al in pairs])
     b = np.array([violation(p[None], al[None], s)[1][0] == 0 for p, al in pairs])
     print(

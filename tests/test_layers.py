@@ -33,6 +33,8 @@ RANKS = {
     "measure": 6,
     # fits tau and w to a friction test: units and the physics, used by the face and the CLI
     "calibration": 3,
+    # data made for the tests and benchmarks (laws near the edge of reach)
+    "_testing": 2,
     "api": 7,
     "__init__": 7,  # the lazy face, ``import metainterface as mi``
     "reproduce": 7,
@@ -130,11 +132,25 @@ def test_no_import_circle_between_modules() -> None:
     assert _cycles(_imports()) == []
 
 
+def rooms(edges: dict[str, set[str]]) -> dict[str, set[str]]:
+    """{room: the rooms its modules import} (a room: a subpackage or a top-level module)."""
+    out: dict[str, set[str]] = {}
+    for a, bs in edges.items():
+        out.setdefault(_room(a), set()).update(_room(b) for b in bs if _room(b) != _room(a))
+    return out
+
+
+def test_no_import_circle_between_rooms() -> None:
+    # rooms of one rank may import each other, but one way only: a circle (inverse ->
+    # units -> inverse) means two rooms share a concern
+    assert _cycles(rooms(_imports())) == []
+
+
 def test_no_import_up_the_layers() -> None:
     assert upward(_imports()) == []
 
 
 if __name__ == "__main__":  # list what the tests would refuse
     e = _imports()
-    print("\n".join(map(str, _cycles(e))))
+    print("\n".join(map(str, _cycles(e) + _cycles(rooms(e)))))
     print("\n".join(upward(e)))

@@ -8,31 +8,15 @@ import numpy as np
 import pytest
 
 import metainterface as mi
-from metainterface.units.reach import alpha_bounds
+from metainterface._testing import borderline_laws
 
 UNITS = dict(shear_strength="0.25MPa", modulus="2MPa", radius="0.5mm", area="4cm2")
 TAU, E_STAR, AREA = 0.25e6, 2e6, 4e-4
 
 
-def _laws(count: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Power laws alpha = top (P*/P*_max)^m whose top point lies from a little below the
-    exact pointwise bounds to a little above them: the region where the two envelopes the
-    package used to have disagreed on 10 % of such laws."""
-    rng = np.random.default_rng(seed)
-    _, _, reach = alpha_bounds(np.array([1e-3]))
-    out = []
-    for _ in range(count):
-        p_max = reach * rng.uniform(0.1, 1.0)
-        p = np.linspace(p_max / 25, p_max, 16)
-        lo, hi, _ = alpha_bounds(p)
-        top = lo[-1] + rng.uniform(-0.2, 1.2) * (hi[-1] - lo[-1])
-        out.append((p, top * (p / p_max) ** rng.uniform(0.3, 1.2)))
-    return out
-
-
 def test_reachability_and_feasible_scale_agree(tmp_path):
     verdicts = []
-    for i, (p, alpha) in enumerate(_laws(24, seed=3)):
+    for i, (p, alpha) in enumerate(borderline_laws(24, seed=3)):
         csv = tmp_path / f"law{i}.csv"
         fn, ff = p * AREA * E_STAR, alpha * TAU * AREA
         csv.write_text(
