@@ -290,9 +290,7 @@ def _topography(fig, ax, design, idle: Sequence[int] = ()) -> list:
         xlim=(0, side),
         ylim=(0, side),
         aspect="equal",
-        title="cell from above\n"
-        + "white: contact at Δmax"
-        + (", red x: idle" if idle else ""),
+        title="cell from above\nwhite: contact at Δmax" + (", red x: idle" if idle else ""),
         xlabel="x / R",
         ylabel="y / R",
     )
