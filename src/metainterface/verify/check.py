@@ -36,12 +36,10 @@ GRID_PER_ASPERITY = 128
 #: Default number of loads of the check.
 DEFAULT_LOADS = 10
 #: Polonsky-Keer-Rey tolerance of the check's solves. The check measures errors of a tenth
-#: of a per cent; at 1e-7 every alpha of the built-in targets' designs at the default grid
-#: and loads is the 1e-11 solve's (the paper's, ``mi.validate``'s default) to 4e-5
-#: relative (saturating and bilinear 6e-7), their BEM errors the same to three digits
-#: (0.29186 -> 0.29188 %, 0.19543 -> 0.19544 %, 3.44131 -> 3.44122 %), in 55 % of
-#: the iterations (1e-8: 66 %; docs/concepts/verification.md).
-CHECK_TOLERANCE = 1e-7
+#: of a per cent; at 1e-8 every alpha of the built-in targets' designs is the 1e-11
+#: solve's (the paper's, ``mi.validate``'s default) to 6e-8 relative, in 40 % fewer
+#: iterations (docs/concepts/verification.md).
+CHECK_TOLERANCE = 1e-8
 #: Loads a process of the check solves at least, so that starting it (a fork, the height
 #: map) stays small beside its solves. A chunk's cold first load cost no more than a
 #: warm-started one (saturating at 384^2: 0.46 s against 0.5-0.6 s).
