@@ -15,6 +15,8 @@ missed by 4-39 %.
 from __future__ import annotations
 
 import functools
+from dataclasses import asdict
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -48,11 +50,57 @@ def reachable_envelope(
     return lo_q, hi_q, reach
 
 
+#: The default cell's envelope (the family of ``reachable_envelope``'s defaults, 256
+#: pressures), precomputed: computing it took 0.8 s of CPU, in every process that designs or
+#: tests a law (a README design took ~8 s in all). Written by ``python -m
+#: metainterface.inverse.envelope``; tests/inverse/test_envelope.py computes it afresh and
+#: compares. Any other cell, family or grid is computed (once per process).
+SHIPPED = Path(__file__).resolve().parents[1] / "weights" / "envelope.npz"
+_DEFAULT = (2000, 0, 256)
+
+
+def _key(settings: CellSettings, samples: int, seed: int, points: int) -> str:
+    """What an envelope was computed for, as text (stored with the shipped one)."""
+    return repr((sorted(asdict(settings).items()), samples, seed, points))
+
+
 @functools.lru_cache(maxsize=8)
 def _envelope(
     settings: CellSettings, samples: int, seed: int, points: int = 256
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """The family's envelope on ``points`` pressures over [0, P*_reach]."""
+    """The family's envelope on ``points`` pressures over [0, P*_reach]: the shipped one
+    for the default cell and family, else computed."""
+    if (samples, seed, points) == _DEFAULT and settings == CellSettings():
+        shipped = _shipped(_key(settings, samples, seed, points))
+        if shipped is not None:
+            return shipped
+    return compute_envelope(settings, samples, seed, points)
+
+
+def _shipped(key: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, float] | None:
+    """The shipped envelope if it was computed for ``key`` (else None: compute it)."""
+    try:
+        with np.load(SHIPPED) as f:
+            if str(f["key"]) != key:
+                return None
+            return f["grid"].copy(), f["lo"].copy(), f["hi"].copy(), float(f["reach"])
+    except (OSError, KeyError, ValueError):
+        return None
+
+
+def write_shipped(path: Path = SHIPPED) -> Path:
+    """Compute the default cell's envelope and write it where ``_envelope`` reads it."""
+    args = (CellSettings(), *_DEFAULT)
+    grid, lo, hi, reach = compute_envelope(*args)
+    np.savez(path, key=np.array(_key(*args)), grid=grid, lo=lo, hi=hi, reach=np.array(reach))
+    return path
+
+
+def compute_envelope(
+    settings: CellSettings, samples: int, seed: int, points: int = 256
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The family's envelope on ``points`` pressures over [0, P*_reach], computed:
+    (grid (points,), lo, hi (points,), P*_reach)."""
     n = settings.n_asperities
     gammas = torch.linspace(settings.gamma_min, settings.gamma_max, 12, dtype=DTYPE)
     uniform = gammas[:, None].expand(-1, n)
@@ -115,3 +163,7 @@ def reachability_warnings(target: Target, settings: CellSettings) -> list[str]:
             f"({int(outside.sum())} of {target.p_star.size} points outside)"
         )
     return out
+
+
+if __name__ == "__main__":  # pragma: no cover - regenerates the shipped file
+    print(write_shipped())

@@ -20,6 +20,9 @@ from metainterface._files.provenance import compact_provenance
 from metainterface.errors import MetainterfaceError
 
 _FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
+#: Digits and minus as superscripts: a power of ten in plain text ('×10⁻³'), not mathtext,
+#: whose parser costs a figure 0.3 s or more to build.
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 #: Longest title text drawn; longer names are cut in the middle.
 TITLE_CHARS = 40
 
@@ -88,7 +91,7 @@ def tidy_axis(ax: Axes, *, x: bool = True, y: bool = True, bins: int = 5) -> Non
             continue
         scale = 10.0**power
         axis.set_major_formatter(FuncFormatter(lambda v, _pos, s=scale: f"{v / s:.4g}"))
-        axis.set_label_text(f"{label} ($\\times 10^{{{power}}}$)")
+        axis.set_label_text(f"{label} (×10{str(power).translate(_SUPERSCRIPT)})")
 
 
 def save_figure(fig: Figure, path: str | os.PathLike[str], **settings: Any) -> Path:
@@ -107,5 +110,7 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], **settings: Any) -> P
         "svg": {"Description": record},
     }[fmt]
     buf = io.BytesIO()
-    fig.savefig(buf, format=fmt, dpi=150, metadata=meta)
+    # zlib level 3, not PIL's 6: a third less time encoding for files about 10 % larger
+    extra = {"pil_kwargs": {"compress_level": 3}} if fmt == "png" else {}
+    fig.savefig(buf, format=fmt, dpi=150, metadata=meta, **extra)
     return write_bytes(path, buf.getvalue())

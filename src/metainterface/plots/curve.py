@@ -16,10 +16,10 @@ def plot_curve(curve, *, title: str | None = None, width: float = 9.0) -> Figure
     fig, (ax_a, ax_s) = panel_grid(2, width, aspect=0.75)
     p = curve.p_star
     ax_a.plot(p, curve.alpha, color="k")
-    ax_a.set(xlabel=r"$P^* = P/E^*$", ylabel=r"$\alpha = A/A_{nom}$", title="contact area")
+    ax_a.set(xlabel="P* = P / E*", ylabel="α = A / Aₙₒₘ", title="contact area")
     touching = curve.alpha > 0  # S* is 0 by convention before the first contact
     ax_s.plot(p[touching], curve.stiffness[touching], color="C0")
-    ax_s.set(xlabel=r"$P^*$", ylabel=r"$S^* = dP^*/d\alpha$", title="stiffness")
+    ax_s.set(xlabel="P*", ylabel="S* = dP* / dα", title="stiffness")
     for ax in (ax_a, ax_s):
         ax.grid(alpha=0.3)
         ax.set_xlim(0, 1.02 * float(p[-1]))
@@ -37,7 +37,7 @@ def draw_curve(ax: Axes, curve, *, label: str | None = None, target=None) -> Axe
         ax.plot(target.p_star, target.alpha, "k-", lw=2, label=f"target {short(target.name)}")
         top = max(top, target.p_star_max)
     ax.plot(curve.p_star, curve.alpha, "--" if target is not None else "-", label=label)
-    ax.set(xlabel=r"$P^* = P/E^*$", ylabel=r"$\alpha = A/A_{nom}$")
+    ax.set(xlabel="P* = P / E*", ylabel="α = A / Aₙₒₘ")
     ax.set_xlim(0, 1.03 * top)
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)

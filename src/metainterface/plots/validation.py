@@ -44,9 +44,9 @@ def plot_validation(
         "o",
         mfc="none",
         color="C3",
-        label=f"BEM ({result.grid}$^2$)",
+        label=f"BEM ({result.grid}²)",
     )
-    ax_c.set(xlabel=r"$P^* = P/E^*$", ylabel=r"$\alpha = A/A_{nom}$", title="contact area")
+    ax_c.set(xlabel="P* = P / E*", ylabel="α = A / Aₙₒₘ", title="contact area")
     ax_c.set_xlim(left=0)
     ax_c.set_ylim(bottom=0)
     ax_c.grid(alpha=0.3)
@@ -81,8 +81,8 @@ def plot_validation(
         extent = (float(x[0]), float(x[-1] + step), float(y[0]), float(y[-1] + step))
         labels = ("x / R", "y / R") if units == "R" else ("x [mm]", "y [mm]")
     im = ax_p.imshow(pressure, origin="lower", extent=extent, cmap="magma")
-    ax_p.set(xlabel=labels[0], ylabel=labels[1], title=rf"$p/E^*$ at $P^* = {p_top:.3g}$")
-    fig.colorbar(im, ax=ax_p, label=r"$p/E^*$", shrink=0.85)
+    ax_p.set(xlabel=labels[0], ylabel=labels[1], title=f"p / E* at P* = {p_top:.3g}")
+    fig.colorbar(im, ax=ax_p, label="p / E*", shrink=0.85)
     tidy_axis(ax_p, bins=4)
     if title:
         fig.suptitle(short(title), fontsize=10)
