@@ -155,7 +155,7 @@ def reachability(
     """Whether a friction law (K,) [N] is reachable at tau [Pa], E* [Pa] and a nominal area
     [m^2] by cells of ``settings``. With ``units=False`` the inputs are P* and alpha (and
     tau = E* = A = 1): the same test on a dimensionless target. adhesion: w / (E* R), for
-    cells of JKR asperities."""
+    cells of JKR asperities (the same test, on the envelope of adhesive cells)."""
     fn = np.asarray(normal_force, dtype=np.float64)
     ff = np.asarray(friction_force, dtype=np.float64)
     keep = fn > 0
@@ -164,16 +164,11 @@ def reachability(
     alpha = ff / (shear_strength * area)
     # the one reach test (feasible_scale and design ask it too); imported here because
     # metainterface.inverse imports this module
-    from metainterface.inverse.envelope import TOLERANCE, reach_violation, reachable_envelope
+    from metainterface.inverse.envelope import reach_violation, reachable_envelope
 
     cell = settings or CellSettings()
-    if adhesion > 0:  # JKR cells: their exact bounds (the scale search takes no adhesion)
-        lo, hi, p_reach = alpha_bounds(p, settings, adhesion)
-        slack = TOLERANCE * alpha.max()
-        ok = (p <= p_reach) & (alpha >= lo - slack) & (alpha <= hi + slack)
-    else:
-        lo, hi, p_reach = reachable_envelope(p, cell)
-        ok = reach_violation(p, alpha, cell) == 0
+    lo, hi, p_reach = reachable_envelope(p, cell, adhesion=adhesion)
+    ok = reach_violation(p, alpha, cell, adhesion=adhesion) == 0
     to_mu = shear_strength / e_star  # mu = (alpha / P*) tau / E*
     law_mu = ff / fn
     within = p <= p_reach
