@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from metainterface._names import (
     DEFAULT_ENGINE,
@@ -228,13 +229,6 @@ def _targets(args: argparse.Namespace) -> list:
 
     targets = [mi.Target.builtin(n) for n in args.target]
     targets += [mi.Target.from_csv(f) for f in args.target_csv]
-    adhesive = getattr(args, "work_of_adhesion", None) is not None
-    if args.friction_csv and adhesive and _scale_free(args):
-        raise mi.MetainterfaceError(
-            "--work-of-adhesion takes a fixed --area, --modulus and --shear-strength "
-            "(the scale is not designed for adhesive contact yet)",
-            argument="--work-of-adhesion",
-        )
     if args.friction_csv and not _scale_free(args):
         from metainterface.inverse.targets import friction_law_target
         from metainterface.units.friction import friction_target_from_options
@@ -252,8 +246,7 @@ def _targets(args: argparse.Namespace) -> list:
         fit = targets[-1].meta["friction"].get("fit")
         if fit is not None:
             print(f"{targets[-1].name}: {fit['summary']}")
-        if not adhesive:  # the scale advice is for adhesionless cells
-            _advise(args, targets[-1].name)
+        _advise(args, targets[-1])
     if not targets:
         raise mi.MetainterfaceError("give at least one --target, --target-csv or --friction-csv")
     return targets
@@ -267,11 +260,15 @@ def _scale_free(args: argparse.Namespace) -> bool:
     )
 
 
-def _advise(args: argparse.Namespace, name: str) -> None:
+def _advise(args: argparse.Namespace, target: Any) -> None:
     """Before designing a friction law at a fixed scale: where it is out of reach, say
     which area, modulus or shear strength would bring it in."""
     import metainterface as mi
 
+    name = target.name
+    # with adhesion each modulus the search tries costs an envelope: ask the target first
+    if args.work_of_adhesion is not None and mi.reachability(target).reachable:
+        return
     fs = mi.feasible_scale(
         args.friction_csv,
         shear_strength=args.shear_strength,
@@ -279,6 +276,7 @@ def _advise(args: argparse.Namespace, name: str) -> None:
         radius=args.radius,
         area=args.area,
         fit=args.fit,
+        work_of_adhesion=args.work_of_adhesion,
     )
     if not fs.reachable:
         for line in fs.summary():
@@ -316,6 +314,7 @@ def _design_scale(args: argparse.Namespace, options: dict) -> list:
         radius=args.radius,
         area=args.area or "auto",
         fit=args.fit,
+        work_of_adhesion=args.work_of_adhesion,
         method=args.method,
         out=args.out,
         **options,

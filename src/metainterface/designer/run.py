@@ -156,8 +156,11 @@ def design(
         raise MetainterfaceError(f"force must be True or False, got {force!r}")
     if settings is not None and not isinstance(settings, CellSettings):
         raise MetainterfaceError("settings must be a CellSettings")
+    fm = model_for_targets(
+        get_model(model), items, given_adhesion(size["work_of_adhesion"], modulus, radius)
+    )
     reach = refuse_unreachable(items, settings, force)  # before any work or file
-    _say_reach(items, settings or CellSettings(), reach)
+    _say_reach(items, settings or CellSettings(), reach, fm.adhesion)
     if out is not None:  # before any work: a bad folder should not cost a design run
         check_output_folder(out)
     _checks.choice("method", method, pipeline.METHODS)
@@ -179,9 +182,6 @@ def design(
         raise MetainterfaceError(f"refine must be True or False, got {refine!r}")
     if not isinstance(full_target, bool):
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
-    fm = model_for_targets(
-        get_model(model), items, given_adhesion(size["work_of_adhesion"], modulus, radius)
-    )
     checks = as_verify(verify, device)
     adhesive_checks = None
     if checks is not None and fm.adhesion:  # checked in the adhesive BEM, not corrected
@@ -314,11 +314,14 @@ def _verify_all(
     return out
 
 
-def _say_reach(items: list[Target], settings: CellSettings, reach: dict[str, Any]) -> None:
+def _say_reach(
+    items: list[Target], settings: CellSettings, reach: dict[str, Any], adhesion: float
+) -> None:
     """One ReachWarning per target the reach test finds partly out of reach, before the
-    work starts (a friction law out of reach got here only with force=True)."""
+    work starts (a friction law out of reach got here only with force=True); adhesion:
+    w / (E* R) of the model's cells."""
     for t in items:
-        lines = reachability_warnings(t, settings)
+        lines = reachability_warnings(t, settings, adhesion)
         if t.name in reach and not reach[t.name].reachable:
             lines = [f"friction law {t.name}: " + reach[t.name].message.replace("\n", " ")]
         if lines:
@@ -338,7 +341,7 @@ def _pressure(d: Design, limit: float | None, modulus: Any) -> PressureCheck | N
 
 def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> DesignResult:
     d = Design(gamma=r.gamma, h=r.h, settings=r.settings)
-    notes = (*r.notes, *reachability_warnings(r.target, r.settings))
+    notes = (*r.notes, *reachability_warnings(r.target, r.settings, r.model.adhesion))
     pressure = _pressure(d, limit, modulus)
     out = DesignResult(
         target=r.target,

@@ -1,10 +1,9 @@
 """``reachability``: can a cell follow this friction law, at this E*, tau and area?
 
 The answer comes from the one reach test (:mod:`metainterface.inverse.envelope`, which
-``feasible_scale`` and ``design`` ask too; for JKR cells the exact bounds of
-:func:`metainterface.units.reach.alpha_bounds`) and is told in friction terms: the law's
-friction coefficient mu = F_f / F_n against the mu a cell reaches at its loads,
-mu = (alpha / P*) (tau / E*), and what tau or area would make it reachable.
+``feasible_scale`` and ``design`` ask too, with or without adhesion) and is told in friction
+terms: the law's friction coefficient mu = F_f / F_n against the mu a cell reaches at its
+loads, mu = (alpha / P*) (tau / E*), and what tau or area would make it reachable.
 """
 
 from __future__ import annotations
@@ -22,7 +21,6 @@ from metainterface.inverse.envelope import TOLERANCE, reach_violation, reachable
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
 from metainterface.units.friction import FrictionLaw, friction_target_in_units
-from metainterface.units.reach import alpha_bounds
 
 
 @uses_threads()
@@ -206,7 +204,7 @@ def law_reachability(
     """Whether a friction law (K,) [N] is reachable at tau [Pa], E* [Pa] and a nominal area
     [m^2] by cells of ``settings``. With ``units=False`` the inputs are P* and alpha (and
     tau = E* = A = 1): the same test on a dimensionless target. adhesion: w / (E* R), for
-    cells of JKR asperities."""
+    cells of JKR asperities (the same test, on the envelope of adhesive cells)."""
     fn = np.asarray(normal_force, dtype=np.float64)
     ff = np.asarray(friction_force, dtype=np.float64)
     keep = fn > 0
@@ -214,13 +212,8 @@ def law_reachability(
     p = fn / (area * e_star)
     alpha = ff / (shear_strength * area)
     cell = settings or CellSettings()
-    if adhesion > 0:  # JKR cells: their exact bounds (the scale search takes no adhesion)
-        lo, hi, p_reach = alpha_bounds(p, settings, adhesion)
-        slack = TOLERANCE * alpha.max()
-        ok = (p <= p_reach) & (alpha >= lo - slack) & (alpha <= hi + slack)
-    else:
-        lo, hi, p_reach = reachable_envelope(p, cell)
-        ok = reach_violation(p, alpha, cell) == 0
+    lo, hi, p_reach = reachable_envelope(p, cell, adhesion=adhesion)
+    ok = reach_violation(p, alpha, cell, adhesion=adhesion) == 0
     to_mu = shear_strength / e_star  # mu = (alpha / P*) tau / E*
     law_mu = ff / fn
     within = p <= p_reach

@@ -66,11 +66,13 @@ def _law_and_scale(
     radius: Any,
     area: Any,
     fit: str,
+    work_of_adhesion: Any = None,
 ) -> tuple[Any, Any, dict[str, float], str | None, tuple[float, float] | None]:
-    """(law, fit, given SI scale, the variable left free or None, its bounds)."""
+    """(law, fit, given SI scale, the variable left free or None, its bounds); the scale
+    holds ``work_of_adhesion`` [J/m^2] too (0 without adhesion)."""
     from metainterface.units.friction import prepare_law
     from metainterface.units.plausible import warn_unit_slips
-    from metainterface.units.quantities import parse_length
+    from metainterface.units.quantities import parse_length, parse_work_of_adhesion
 
     values = {"area": area, "modulus": modulus, "shear_strength": shear_strength}
     given: dict[str, float] = {}
@@ -89,8 +91,12 @@ def _law_and_scale(
     var, span = free[0] if free else (None, None)
     if var is not None:  # the search starts from the middle of the range
         given[var] = math.sqrt(span[0] * span[1]) if span else math.nan
-    law, lf = prepare_law(law, fit)
+    work = 0.0
+    if work_of_adhesion is not None:
+        work = parse_work_of_adhesion(work_of_adhesion, option="work_of_adhesion")
+    law, lf = prepare_law(law, fit, offset=work > 0)
     given["radius"] = parse_length(radius, option="radius")
+    given["work_of_adhesion"] = work
     warn_unit_slips(
         **{k: given[k] for k in ("modulus", "shear_strength", "radius") if k != var},
     )
@@ -99,12 +105,19 @@ def _law_and_scale(
 
 def _reference(law: Any, given: dict[str, float], var: str | None) -> dict[str, float]:
     """The given scale, an 'auto' variable set where the law's largest point sits at half
-    the cell's largest reachable P* (area, modulus) or alpha = 0.02 (tau)."""
+    the cell's largest reachable P* (area, modulus) or alpha = 0.02 (tau); with adhesion,
+    the adhesive cell's P* at the given modulus (the adhesionless one for a free modulus)."""
     if var is None or math.isfinite(given[var]):
         return given
     from metainterface.inverse.envelope import reachable_envelope
 
-    _, _, reach = reachable_envelope(np.zeros(1), CellSettings())
+    w = (
+        0.0
+        if var == "modulus"
+        else given["work_of_adhesion"] / (given["modulus"] * given["radius"])
+    )
+    _, _, reach = reachable_envelope(np.zeros(1), CellSettings(), adhesion=w)
+    reach = reach if reach > 0 else reachable_envelope(np.zeros(1), CellSettings())[2]
     fn, ff = float(law.normal_force.max()), float(law.friction_force.max())
     g = dict(given)
     if var == "area":
@@ -126,6 +139,7 @@ def feasible_scale(
     area: str | float,
     settings: CellSettings | None = None,
     fit: str = "auto",
+    work_of_adhesion: str | float | None = None,
 ) -> _scale.FeasibleScale:
     """Which area, modulus E* or shear strength tau makes a friction law reachable.
 
@@ -133,22 +147,33 @@ def feasible_scale(
     :meth:`Target.from_friction` (``fit``). shear_strength, modulus, radius, area: the scale
     as given ('0.25MPa', '2MPa', '0.5mm', '4cm2', or SI numbers); one of area, modulus,
     shear_strength may be a range ('2cm2..10cm2') to search within. The radius moves nothing
-    (P* and alpha are averages over the area); it sets how many cells tile it.
+    (P* and alpha are averages over the area); it sets how many cells tile it, and with
+    adhesion w / (E* R). work_of_adhesion: w ('50mJ/m2' or J/m^2) for an adhesive contact
+    (JKR asperities, as :func:`~metainterface.reachability` and
+    :func:`~metainterface.design` take it): an offset F_f(0) > 0 is then accepted and the
+    cells tested are adhesive ones, with the same reach test those ask.
 
     Returns a FeasibleScale: ``.reachable`` at the given scale, ``.ranges`` per variable
     (SI intervals that make it reachable, the other two as given), ``.best``,
     ``.summary()`` (lines in the user's units, e.g. 'reachable with an area of 6.1-9.8
     cm^2'), ``.record()``.
     """
-    law, _, given, var, span = _law_and_scale(law, shear_strength, modulus, radius, area, fit)
+    law, _, given, var, span = _law_and_scale(
+        law, shear_strength, modulus, radius, area, fit, work_of_adhesion
+    )
     return _feasible(law, given, var, span, settings)[1]
 
 
 def _feasible(
-    law: Any, given: dict, var: str | None, span: Any, settings: CellSettings | None
+    law: Any,
+    given: dict,
+    var: str | None,
+    span: Any,
+    settings: CellSettings | None,
+    variables: tuple[str, ...] = _scale.VARIABLES,
 ) -> tuple[dict, _scale.FeasibleScale]:
     """The scale as given, completed where free (``_reference``), and the law's feasible
-    scale there, ``var`` searched within ``span``."""
+    scale there, ``var`` searched within ``span`` (of the ``variables`` searched)."""
     given = _reference(law, given, var)
     fs = _scale.feasible_scale(
         law.normal_force,
@@ -159,6 +184,8 @@ def _feasible(
         radius=given["radius"],
         settings=settings,
         bounds=None if span is None else {var: span},
+        work_of_adhesion=given["work_of_adhesion"],
+        variables=variables,
     )
     return given, fs
 
@@ -168,6 +195,12 @@ def _candidates(fs: _scale.FeasibleScale, var: str, count: int) -> np.ndarray:
     the least-violating value."""
     spans = fs.ranges[var]
     lo_b, hi_b = fs.bounds[var]
+    if spans and _coarse(fs, var):  # the grid points tested, spread over the widest range
+        lo, hi = max(spans, key=lambda s: s[1] / s[0])
+        grid = _scale.scan_grid((lo_b, hi_b), True)
+        inside = grid[(grid >= lo * (1 - 1e-9)) & (grid <= hi * (1 + 1e-9))]
+        pick = np.unique(np.round(np.linspace(0, inside.size - 1, min(count, inside.size))))
+        return inside[pick.astype(int)]
     if spans:
         lo, hi = spans[0][0], spans[-1][1]
         if len(spans) > 1:  # several ranges: the widest one
@@ -177,6 +210,12 @@ def _candidates(fs: _scale.FeasibleScale, var: str, count: int) -> np.ndarray:
         return np.geomspace(lo * inner, hi / inner, count) if hi / lo > 1.01 else np.array([lo])
     b = fs.best[var]
     return np.clip(np.geomspace(b / 1.3, b * 1.3, count), lo_b, hi_b)
+
+
+def _coarse(fs: _scale.FeasibleScale, var: str) -> bool:
+    """Whether ``var`` was searched on the coarse grid (the modulus with adhesion): its
+    candidates are then the grid points tested, not values between them."""
+    return bool(fs.work_of_adhesion) and var == "modulus"
 
 
 def uncovered(result: Any) -> float:
@@ -226,6 +265,7 @@ def design_scale(
     fit: str = "auto",
     name: str | None = None,
     candidates: int = CANDIDATES,
+    work_of_adhesion: str | float | None = None,
     **options: Any,
 ) -> Any:
     """Design a cell for a friction law with the scale chosen together with it.
@@ -241,6 +281,10 @@ def design_scale(
     A candidate's score is its quick design's relative curve error plus the share of the
     law's pressure range the design does not reach by Delta_max.
 
+    work_of_adhesion: w ('50mJ/m2' or J/m^2) for an adhesive contact: the law may have
+    F_f(0) > 0, the scale search tests adhesive cells (:func:`feasible_scale`) and every
+    candidate is designed with JKR asperities of w / (E* R) at its scale.
+
     Returns the DesignResult; ``result.target.meta["scale"]`` holds the chosen value, the
     tiling it gives (cells and cells per side), the candidates and their scores and the
     feasibility summary, and design.json records them.
@@ -249,7 +293,18 @@ def design_scale(
     from metainterface.units.friction import FrictionLaw, friction_target
 
     source = str(law) if not isinstance(law, FrictionLaw) else law.source
-    law, lf, given, var, span = _law_and_scale(law, shear_strength, modulus, radius, area, fit)
+    in_scale = getattr(options.get("scale"), "work_of_adhesion", None)  # mi.Scale(...)
+    if in_scale is not None:
+        if work_of_adhesion is not None:
+            raise MetainterfaceError(
+                "give the work of adhesion once: work_of_adhesion= or "
+                "scale=mi.Scale(work_of_adhesion=...)",
+                argument="work_of_adhesion",
+            )
+        work_of_adhesion = in_scale
+    law, lf, given, var, span = _law_and_scale(
+        law, shear_strength, modulus, radius, area, fit, work_of_adhesion
+    )
     if var is None:
         raise MetainterfaceError(
             "design_scale: give area, modulus or shear_strength as 'auto' or a range "
@@ -258,7 +313,9 @@ def design_scale(
     if not isinstance(candidates, int) or not 1 <= candidates <= 32:
         raise MetainterfaceError(f"candidates must be an integer in [1, 32], got {candidates!r}")
     s = settings or CellSettings()
-    given, fs = _feasible(law, given, var, span, s)
+    # with adhesion each modulus searched has an envelope of its own: only the free variable
+    searched = (var,) if given["work_of_adhesion"] else _scale.VARIABLES
+    given, fs = _feasible(law, given, var, span, s, searched)
     values = _candidates(fs, var, candidates)
     stem = name or (os.path.splitext(os.path.basename(source))[0] or "friction")
 
@@ -272,6 +329,7 @@ def design_scale(
             area=at["area"],
             settings=settings,
             fit="never",
+            work_of_adhesion=at["work_of_adhesion"],
         )
         record = ft.record()
         if lf is not None:
@@ -302,17 +360,26 @@ def design_scale(
     quick_opts = {k: v for k, v in options.items() if k in ("method", "model")}
 
     def quick(vals: np.ndarray) -> np.ndarray:
-        made = design(
-            [target(v, f"{stem}-{i}") for i, v in enumerate(vals)],
-            settings=settings,
-            effort=effort,
-            verify=False,  # candidates are ranked on the model; the chosen one is checked
-            **quick_opts,
-        )
+        targets = [target(v, f"{stem}-{i}") for i, v in enumerate(vals)]
+        # one batch shares one model: candidate moduli with adhesion differ in w / (E* R)
+        batches = [[t] for t in targets] if _coarse(fs, var) else [targets]
+        made = [
+            r
+            for batch in batches
+            for r in design(
+                batch,
+                settings=settings,
+                effort=effort,
+                verify=False,  # candidates are ranked on the model; the chosen one is checked
+                **quick_opts,
+            )
+        ]
         return np.array([r.error + uncovered(r) for r in made])
 
     errors = quick(values)
-    if values.size >= 3:  # a second round between the best and its neighbours
+    # a second round between the best and its neighbours (not on a coarse grid: its points
+    # are the values tested)
+    if values.size >= 3 and not _coarse(fs, var):
         more = _closer(values, errors)
         if more.size:
             values = np.concatenate([values, more])
@@ -340,7 +407,8 @@ def design_scale(
             },
         },
     )
-    size = {**size, "modulus": at["modulus"], "radius": at["radius"]}
+    # the target carries the work of adhesion (w / (E* R) at the chosen scale)
+    size = {**size, "modulus": at["modulus"], "radius": at["radius"], "work_of_adhesion": None}
     if size["total_force"] is None:
         size["area"] = at["area"]
     options.update(as_groups(knobs, size, made_errors, options.get("robust", False)))

@@ -10,6 +10,12 @@ reaches, at each P*, an envelope of alpha (:func:`~metainterface.inverse.pipelin
 reachable_envelope`); a scale is feasible when every point of the law lies inside it (within
 ``tolerance``) and below the largest P* any design reaches. The envelope is pointwise, so a
 feasible scale is necessary for a close design, not a proof of one: the design decides.
+
+With a work of adhesion w [J/m^2] the cells are JKR cells of adhesion w / (E* R) (issue 38),
+and the envelope is theirs: area and tau leave w / (E* R) as it is, the modulus moves it, so
+each modulus searched has an envelope of its own (computed once each, cached). The modulus
+is then searched on a coarser grid (``ADHESIVE_PER_DECADE``) within ``ADHESIVE_DECADES``
+of the given value, and no softer than w / (E* R) <= ``ADHESION_LIMIT`` allows.
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ import numpy as np
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.envelope import TOLERANCE, reach_violation
 from metainterface.physics.cell import CellSettings
+from metainterface.physics.jkr import ADHESION_LIMIT
 
 #: The scale variables: how a factor k on each moves the target (P*, alpha).
 VARIABLES = ("area", "modulus", "shear_strength")
@@ -30,6 +37,10 @@ VARIABLES = ("area", "modulus", "shear_strength")
 #: step: finer than any unit the ranges are reported in).
 DECADES = 3.0
 PER_DECADE = 230
+#: With adhesion, the modulus's search: decades either side and grid points per decade
+#: (each point an adhesive envelope of its own, ~0.5-1 s on two CPU cores).
+ADHESIVE_DECADES = 1.0
+ADHESIVE_PER_DECADE = 10
 
 
 def _moved(p: np.ndarray, a: np.ndarray, variable: str, k: np.ndarray) -> tuple[Any, Any]:
@@ -43,12 +54,17 @@ def _moved(p: np.ndarray, a: np.ndarray, variable: str, k: np.ndarray) -> tuple[
 
 
 def violation(
-    p_star: np.ndarray, alpha: np.ndarray, settings: CellSettings, tolerance: float = TOLERANCE
+    p_star: np.ndarray,
+    alpha: np.ndarray,
+    settings: CellSettings,
+    tolerance: float = TOLERANCE,
+    adhesion: float | np.ndarray = 0.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """How far targets (S, K) leave the reachable envelope: (mean violation (S,), points
     outside (S,)), from the one reach test (:func:`~metainterface.inverse.envelope.
-    reach_violation`) that ``reachability`` and ``design`` ask too."""
-    v = reach_violation(p_star, alpha, settings, tolerance)
+    reach_violation`) that ``reachability`` and ``design`` ask too. adhesion: w / (E* R),
+    one number or one per target (S,)."""
+    v = reach_violation(p_star, alpha, settings, tolerance, adhesion=adhesion)
     return v.mean(-1), (v > 0).sum(-1)
 
 
@@ -73,6 +89,8 @@ class FeasibleScale:
     best_outside: dict[str, int]
     bounds: dict[str, tuple[float, float]] = field(default_factory=dict)
     cell_area: float = 0.0
+    #: The work of adhesion w [J/m^2] the cells were tested with (0: none).
+    work_of_adhesion: float = 0.0
 
     @property
     def reachable(self) -> bool:
@@ -84,7 +102,7 @@ class FeasibleScale:
         'radius'}): the given one with the first of area, modulus, shear strength that has a
         feasible range set to its best value there; where none has, the one that leaves the
         fewest points outside set to its closest value."""
-        var = next((v for v in ("area", "modulus", "shear_strength") if self.ranges[v]), None)
+        var = next((v for v in VARIABLES if self.ranges.get(v)), None)
         if var is None:
             var = min(self.best, key=lambda v: self.best_outside[v])
         return {**self.given, var: self.best[var]}
@@ -98,6 +116,8 @@ class FeasibleScale:
         """One or two lines in the user's units: reachable or not, and what to change."""
         g = self.given
         at = f"E* = {fmt_pressure(g['modulus'])}, tau = {fmt_pressure(g['shear_strength'])}"
+        if self.work_of_adhesion:
+            at += f", w = {self.work_of_adhesion * 1e3:.3g} mJ/m^2"
         head = (
             f"reachable at the given scale (area {fmt_area(g['area'])}, {at})"
             if self.reachable
@@ -116,7 +136,9 @@ class FeasibleScale:
         else:
             var = min(self.best, key=lambda v: self.best_outside[v])
             tail = (
-                f"no area, E* or tau within 10^{DECADES:g} of the given makes it reachable; "
+                f"no area, E* or tau within the searched range (10^{DECADES:g} of the given"
+                + (f"; E* 10^{ADHESIVE_DECADES:g} with adhesion" if self.work_of_adhesion else "")
+                + ") makes it reachable; "
                 f"closest: {_NAMES[var]} {_fmt(var, self.best[var])} "
                 f"({self.best_outside[var]} points outside)"
             )
@@ -131,6 +153,7 @@ class FeasibleScale:
             "ranges": {k: [list(s) for s in v] for k, v in self.ranges.items()},
             "best": self.best,
             "best_outside": self.best_outside,
+            "work_of_adhesion_j_m2": self.work_of_adhesion,
             "summary": self.summary(),
         }
 
@@ -186,6 +209,16 @@ def _merged(runs: list[tuple[int, int]], values: np.ndarray) -> list[tuple[int, 
     return out
 
 
+def scan_grid(bounds: tuple[float, float], adhesive_modulus: bool = False) -> np.ndarray:
+    """The values [SI] a variable is tested at within ``bounds``: a log grid of
+    ``PER_DECADE`` points a decade (``ADHESIVE_PER_DECADE`` for the modulus with adhesion,
+    each point of which has an envelope of its own)."""
+    lo, hi = bounds
+    per_decade = ADHESIVE_PER_DECADE if adhesive_modulus else PER_DECADE
+    steps = max(2, round(math.log10(hi / lo) * per_decade) + 1)
+    return np.geomspace(lo, hi, steps)
+
+
 def scan(
     p_star: np.ndarray,
     alpha: np.ndarray,
@@ -193,14 +226,16 @@ def scan(
     given: float,
     bounds: tuple[float, float],
     settings: CellSettings,
+    adhesion: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(values (S,) SI, mean violation (S,), points outside (S,)) over a log grid of the
-    variable within ``bounds``, from the target at the ``given`` value."""
-    lo, hi = bounds
-    steps = max(2, round(math.log10(hi / lo) * PER_DECADE) + 1)
-    values = np.geomspace(lo, hi, steps)
+    variable within ``bounds``, from the target at the ``given`` value. adhesion: w / (E* R)
+    at the given value (the modulus moves it: w / (E* R) scales as 1 / E*)."""
+    moves_w = bool(adhesion) and variable == "modulus"
+    values = scan_grid(bounds, moves_w)
     p, a = _moved(p_star, alpha, variable, values / given)
-    v, out = violation(np.asarray(p), np.asarray(a), settings)
+    w = adhesion * given / values if moves_w else adhesion
+    v, out = violation(np.asarray(p), np.asarray(a), settings, adhesion=w)
     return values, v, out
 
 
@@ -214,26 +249,44 @@ def feasible_scale(
     radius: float,
     settings: CellSettings | None = None,
     bounds: dict[str, tuple[float, float]] | None = None,
+    work_of_adhesion: float = 0.0,
+    variables: tuple[str, ...] = VARIABLES,
 ) -> FeasibleScale:
     """Which area, modulus or shear strength makes the law (F_n, F_f) (K,) [N] reachable.
 
     area [m^2], modulus E* [Pa], shear_strength tau [Pa], radius R [m]: the scale given.
     bounds: per variable, (low, high) [SI] to search in (default 10^-3 to 10^3 times the
-    given value; the area at least one cell (L R)^2 and large enough that alpha < 1).
+    given value, the modulus 10^-1 to 10^1 with adhesion; the area at least one cell (L R)^2
+    and large enough that alpha < 1; the modulus at least w / (R ADHESION_LIMIT)).
+    work_of_adhesion: w [J/m^2] >= 0, for cells of JKR asperities. variables: the ones
+    searched (the others have no ranges; ``design_scale`` searches only its free one).
     """
     s = settings or CellSettings()
+    work = float(work_of_adhesion)
+    if not (math.isfinite(work) and work >= 0):
+        raise MetainterfaceError(f"work of adhesion must be >= 0 J/m^2, got {work_of_adhesion!r}")
+    if work > ADHESION_LIMIT * modulus * radius:
+        raise MetainterfaceError(
+            f"work of adhesion must be in [0, {ADHESION_LIMIT * modulus * radius:g}] J/m^2 "
+            f"(up to {ADHESION_LIMIT:g} E* R) at the given modulus, got {work:g}",
+            argument="work_of_adhesion",
+        )
+    w0 = work / (modulus * radius)  # w / (E* R) at the given modulus
     given = {"area": area, "modulus": modulus, "shear_strength": shear_strength}
     fn = np.asarray(normal_force, dtype=np.float64)
     ff = np.asarray(friction_force, dtype=np.float64)
     p0, a0 = fn / (area * modulus), ff / (shear_strength * area)
     cell_area = (s.cell_side / s.radius * radius) ** 2
-    _, out0 = violation(p0[None], a0[None], s)
+    _, out0 = violation(p0[None], a0[None], s, adhesion=w0)
     lim = {v: (given[v] * 10**-DECADES, given[v] * 10**DECADES) for v in VARIABLES}
-    # alpha < 1 needs A > F_f / tau and tau > F_f / A; the area holds at least one cell
+    if work:
+        lim["modulus"] = (modulus * 10**-ADHESIVE_DECADES, modulus * 10**ADHESIVE_DECADES)
+    # alpha < 1 needs A > F_f / tau and tau > F_f / A; the area holds at least one cell;
+    # w / (E* R) within the adhesive model's range
     floor = {
         "area": max(cell_area, float(ff.max()) / shear_strength * 1.0001),
         "shear_strength": float(ff.max()) / area * 1.0001,
-        "modulus": 0.0,
+        "modulus": work / (radius * ADHESION_LIMIT),
     }
     lim = {v: (max(lo, floor[v]), hi) for v, (lo, hi) in lim.items()}
     for var, (lo, hi) in (bounds or {}).items():
@@ -243,12 +296,12 @@ def feasible_scale(
     ranges: dict[str, list[tuple[float, float]]] = {}
     best: dict[str, float] = {}
     best_out: dict[str, int] = {}
-    for var in VARIABLES:
+    for var in variables:
         lo, hi = lim[var]
         if not lo < hi:
             ranges[var], best[var], best_out[var] = [], lo, int(p0.size)
             continue
-        values, v, out = scan(p0, a0, var, given[var], (lo, hi), s)
+        values, v, out = scan(p0, a0, var, given[var], (lo, hi), s, adhesion=w0)
         runs = _merged(_runs(out == 0), values)
         ranges[var] = [(float(values[i]), float(values[j])) for i, j in runs]
         if runs:  # the middle (in log) of the widest range: the most room either side
@@ -267,4 +320,5 @@ def feasible_scale(
         best_outside=best_out,
         bounds=lim,
         cell_area=cell_area,
+        work_of_adhesion=work,
     )

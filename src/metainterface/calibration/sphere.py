@@ -19,7 +19,6 @@ The result feeds ``--shear-strength`` and ``--work-of-adhesion`` of ``design``.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -54,6 +53,8 @@ class Calibration:
 
     tau_sigma, work_sigma: standard errors; covariance: (2, 2) of (tau, w); rows: data
     points used; residual_rms: rms relative residual; radius [m], e_star [Pa]: as given.
+    contact: what was tested, for the summary ("JKR sphere", or the design's cell with its
+    area); area: the nominal area of a made design's patch [m^2] (0 for a sphere).
     """
 
     tau: float
@@ -65,6 +66,8 @@ class Calibration:
     residual_rms: float
     radius: float
     e_star: float
+    contact: str = "JKR sphere"
+    area: float = 0.0
 
     def interval(self, level: float = 0.95) -> dict[str, tuple[float, float]]:
         """{'tau': (lo, hi), 'work': (lo, hi)}: the two-sided ``level`` ranges (Student's t
@@ -93,7 +96,8 @@ class Calibration:
             f"w   = {self.work * 1e3:.4g} mJ/m^2 +- {self.work_sigma * 1e3:.2g} mJ/m^2 "
             f"(95 %: {ci['work'][0] * 1e3:.4g}-{ci['work'][1] * 1e3:.4g} mJ/m^2)",
             f"fit: {self.rows} rows, rms relative residual {100 * self.residual_rms:.2g} % "
-            f"(JKR sphere, R = {self.radius * 1e3:.4g} mm, E* = {self.e_star / 1e6:.4g} MPa)",
+            f"({self.contact}, R = {self.radius * 1e3:.4g} mm, E* = {self.e_star / 1e6:.4g} MPa"
+            + (f", area {self.area * 1e4:.4g} cm^2)" if self.area else ")"),
             f"use: {self.options()}",
         ]
 
@@ -101,7 +105,9 @@ class Calibration:
         """JSON-ready, SI."""
         ci = self.interval()
         return {
-            "model": "JKR sphere, F_f = tau pi a^2",
+            "model": "JKR sphere, F_f = tau pi a^2"
+            if not self.area
+            else f"{self.contact}, F_f = tau alpha A (adhesive model, load control)",
             "shear_strength_pa": self.tau,
             "shear_strength_sigma_pa": self.tau_sigma,
             "work_of_adhesion_j_m2": self.work,
@@ -110,8 +116,9 @@ class Calibration:
             "interval_95": {k: list(v) for k, v in ci.items()},
             "rows": self.rows,
             "residual_rms_relative": self.residual_rms,
-            "sphere_radius_m": self.radius,
+            "sphere_radius_m" if not self.area else "radius_m": self.radius,
             "e_star_pa": self.e_star,
+            **({"area_m2": self.area} if self.area else {}),
             "options": self.options(),
         }
 
@@ -184,20 +191,4 @@ def calibrate_sphere(
         residual_rms=float(math.sqrt(2.0 * best.cost / fn.size)),
         radius=float(radius),
         e_star=float(e_star),
-    )
-
-
-def calibrate_csv(
-    path: str | os.PathLike[str], *, sphere_radius: str | float, modulus: str | float
-) -> Calibration:
-    """:func:`calibrate_sphere` on a friction CSV (``normal_force,friction_force`` [N], or
-    ``normal_force,friction_coefficient``; units in the header), quantities with units."""
-    from metainterface.units.law_file import read_friction_csv
-    from metainterface.units.quantities import parse_length, parse_pressure
-
-    r = parse_length(sphere_radius, option="--sphere-radius")
-    e = parse_pressure(modulus, option="--modulus")
-    law = read_friction_csv(path, check=False)
-    return calibrate_sphere(
-        law.normal_force, law.friction_force, radius=r, e_star=e, source=str(path)
     )

@@ -1,0 +1,71 @@
+"""The scale of an offset friction law with adhesion (issue 38, item 3): what
+``feasible_scale`` and ``design_scale`` cost with a work of adhesion, and what they find.
+
+The law: a held-back adhesive cell's loading curve (PDMS on glass, w = 50 mJ/m^2, E* = 2.4
+MPa, R = 0.5 mm, tau = 0.3 MPa) over 4 cm^2, with its zero-load row (F_f(0) = 1.96 N).
+``feasible_scale`` at 1 cm^2 (out of reach: every variable searched; the modulus with an
+envelope per value) and ``design_scale`` with area='auto' (verify=False).
+
+    PYTHONPATH=src python benchmarks/bench_adhesive_scale.py
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import torch
+
+import metainterface as mi
+from metainterface.physics import CellSettings
+
+E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
+UNITS = dict(shear_strength="0.3MPa", modulus="2.4MPa", radius="0.5mm", fit="never")
+
+
+def law(folder: Path) -> Path:
+    s = CellSettings()
+    rng = np.random.default_rng(11)
+    g = rng.uniform(1.8, 4.0, 9)
+    h = rng.uniform(0, 0.6, 9) * s.delta_max
+    h -= h.min()
+    model = mi.Independent(adhesion=W_J / (E * R))
+    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
+    with torch.no_grad():
+        p_max = float(model.sweep(gt, ht, s, n_delta=2049).p_star[0, -1])
+        p = np.linspace(0, 0.95 * p_max, 24)
+        p[0] = 1e-12 * p_max
+        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
+    p[0] = 0.0
+    path = folder / "pdms.csv"
+    path.write_text(
+        "normal_force,friction_force\n"
+        + "".join(f"{x:.12g},{y:.12g}\n" for x, y in zip(p * AREA * E, a * TAU * AREA, strict=True))
+    )
+    return path
+
+
+def main() -> None:
+    csv = law(Path(tempfile.mkdtemp()))
+    start = time.perf_counter()
+    fs = mi.feasible_scale(csv, area="1cm2", work_of_adhesion="50mJ/m2", **UNITS)
+    print(f"feasible_scale, 1 cm^2: {time.perf_counter() - start:.1f} s")
+    for line in fs.summary():
+        print("  " + line)
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = mi.design_scale(csv, area="auto", work_of_adhesion="50mJ/m2", verify=False, **UNITS)
+    sc = r.target.meta["scale"]
+    print(
+        f"design_scale, area auto: {time.perf_counter() - start:.1f} s; chose "
+        f"{sc['value'] * 1e4:.3g} cm^2 (the law's own: 4 cm^2), error {100 * r.error:.2f} %, "
+        f"model {r.model.label}"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,172 @@
+"""The scale of a friction law with adhesion (issue 38, item 3): ``feasible_scale`` and
+``design_scale`` take a work of adhesion as ``reachability`` and ``design`` do, accept an
+offset law, and the four ask one reach test, on the envelope of adhesive cells."""
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+import torch
+
+import metainterface as mi
+from metainterface.cli import main
+from metainterface.inverse.envelope import reach_violation, reachable_envelope
+from metainterface.physics import CellSettings
+from metainterface.scaling.search import scan_grid
+
+# PDMS on glass: w = 50 mJ/m^2, E* = 2.4 MPa, R = 0.5 mm; tau 0.3 MPa
+E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
+W = W_J / (E * R)
+UNITS = dict(shear_strength="0.3MPa", modulus="2.4MPa", radius="0.5mm")
+
+
+@pytest.fixture(scope="module")
+def law_csv(tmp_path_factory):
+    """A held-back adhesive cell's loading curve at 4 cm^2, as a friction law with its
+    zero-load row: F_f(0) > 0."""
+    s = CellSettings()
+    rng = np.random.default_rng(11)
+    g = rng.uniform(1.8, 4.0, 9)
+    h = rng.uniform(0, 0.6, 9) * s.delta_max
+    h -= h.min()
+    model = mi.Independent(adhesion=W)
+    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
+    with torch.no_grad():
+        p_max = float(model.sweep(gt, ht, s, n_delta=2049).p_star[0, -1])
+        p = np.linspace(0, 0.95 * p_max, 24)
+        p[0] = 1e-12 * p_max  # the zero-load state, just above the snap-in plateau
+        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
+    p[0] = 0.0
+    fn, ff = p * AREA * E, a * TAU * AREA
+    path = tmp_path_factory.mktemp("adhesive") / "pdms.csv"
+    path.write_text(
+        "normal_force,friction_force\n"
+        + "".join(f"{x:.12g},{y:.12g}\n" for x, y in zip(fn, ff, strict=True))
+    )
+    return path
+
+
+def test_the_adhesive_envelope_holds_adhesive_cells_and_starts_above_zero():
+    """The family's envelope for w: random adhesive cells lie inside it, it holds area at
+    zero load (no adhesionless cell does) and tends to the adhesionless one as w -> 0."""
+    s = CellSettings()
+    rng = np.random.default_rng(5)
+    g = torch.as_tensor(rng.uniform(1.8, 4.0, (6, 9)))
+    h = torch.as_tensor(rng.uniform(0, 0.5, (6, 9)) * s.delta_max)
+    with torch.no_grad():
+        sw = mi.Independent(adhesion=W).sweep(g, h, s)
+    p, a = sw.p_star.numpy(), sw.alpha.numpy()
+    assert np.all(reach_violation(p, a, s, tolerance=0.0, adhesion=W) == 0)
+    lo, _, _ = reachable_envelope(np.array([1e-9]), s, adhesion=W)
+    lo0, _, _ = reachable_envelope(np.array([1e-9]), s)
+    assert lo[0] > 100 * lo0[0]
+    q = np.linspace(1e-4, 4e-3, 9)
+    tiny, plain = reachable_envelope(q, s, adhesion=1e-9), reachable_envelope(q, s)
+    np.testing.assert_allclose(tiny[0], plain[0], rtol=0.02)
+    assert tiny[2] == pytest.approx(plain[2], rel=1e-4)
+
+
+def test_feasible_scale_takes_the_work_of_adhesion(law_csv):
+    """The offset law is refused without w, and with it reachable at its own area and out
+    of reach at a quarter of it, with advice in friction terms, w named."""
+    with pytest.raises(mi.MetainterfaceError, match="work-of-adhesion"):
+        mi.feasible_scale(law_csv, area="4cm2", fit="never", **UNITS)
+    fs = mi.feasible_scale(law_csv, area="4cm2", work_of_adhesion="50mJ/m2", fit="never", **UNITS)
+    assert fs.reachable and fs.work_of_adhesion == pytest.approx(W_J)
+    assert any(lo <= AREA <= hi for lo, hi in fs.ranges["area"])
+    assert any(lo <= E <= hi for lo, hi in fs.ranges["modulus"])
+    small = mi.feasible_scale(law_csv, area="1cm2", work_of_adhesion=0.05, fit="never", **UNITS)
+    head, tail = small.summary()
+    assert not small.reachable and "w = 50 mJ/m^2" in head
+    assert "reachable with an area of" in tail
+    assert small.record()["work_of_adhesion_j_m2"] == pytest.approx(W_J)
+
+
+def test_one_answer_on_reach_with_adhesion(law_csv):
+    """reachability, feasible_scale and design agree on the offset law at areas across the
+    edge of its feasible range, and at moduli on both sides of its range's edge (where the
+    modulus moves w / (E* R))."""
+    fs = mi.feasible_scale(law_csv, area="4cm2", work_of_adhesion="50mJ/m2", fit="never", **UNITS)
+    (a_lo, _), *_ = fs.ranges["area"]
+    answers = []
+    for area in a_lo * np.array([0.9, 0.99, 1.01, 1.1, 2.0]):
+        r = mi.reachability(law_csv, area=area, work_of_adhesion="50mJ/m2", **UNITS)
+        f = mi.feasible_scale(law_csv, area=area, work_of_adhesion="50mJ/m2", fit="never", **UNITS)
+        t = mi.Target.from_friction(
+            law_csv, area=area, work_of_adhesion="50mJ/m2", fit="never", **UNITS
+        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                mi.design(t, verify=False, effort=mi.Effort(refine=False, hedge=0, fallback=0))
+                designed = True
+            except mi.UnreachableError:
+                designed = False
+        assert r.reachable == f.reachable == designed, (area, r.message, f.summary())
+        answers.append(r.reachable)
+    assert answers[0] is False and answers[-1] is True
+    # the modulus: the grid points searched just inside and just outside its range
+    (m_lo, m_hi), *_ = fs.ranges["modulus"]
+    grid = scan_grid(fs.bounds["modulus"], True)
+    inside, below = grid[grid >= m_lo * (1 - 1e-9)][0], grid[grid < m_lo * (1 - 1e-9)]
+    r_in = mi.reachability(
+        law_csv,
+        area="4cm2",
+        work_of_adhesion="50mJ/m2",
+        **{**UNITS, "modulus": float(inside)},
+    )
+    assert r_in.reachable
+    if below.size:
+        r_out = mi.reachability(
+            law_csv,
+            area="4cm2",
+            work_of_adhesion="50mJ/m2",
+            **{**UNITS, "modulus": float(below[-1])},
+        )
+        assert not r_out.reachable
+    assert m_hi > E
+
+
+def test_design_scale_designs_an_offset_law_with_its_area(law_csv):
+    """The area chosen with the cell for the offset law (its true area 4 cm^2): in the
+    feasible range, the design adhesive (w / (E* R) at the chosen scale) and close."""
+    r = mi.design_scale(
+        law_csv,
+        area="2cm2..20cm2",
+        work_of_adhesion="50mJ/m2",
+        fit="never",
+        verify=False,
+        **UNITS,
+    )
+    sc = r.target.meta["scale"]
+    assert sc["variable"] == "area" and 2e-4 <= sc["value"] <= 20e-4
+    assert r.model.adhesion == pytest.approx(W)
+    assert r.target.meta["friction"]["work_of_adhesion_j_m2"] == pytest.approx(W_J)
+    assert any(lo <= sc["value"] <= hi for lo, hi in sc["feasibility"]["ranges"]["area"])
+    assert r.error < 0.05
+    assert mi.reachability(r.target).reachable
+
+
+def test_design_cli_area_auto_with_work_of_adhesion(law_csv, tmp_path, capsys):
+    """The user's call: --area auto with --work-of-adhesion designs the scale and the cell
+    with adhesive asperities; a fixed area out of reach is answered with the adhesive
+    scale advice."""
+    base = ["design", "--friction-csv", str(law_csv), "--shear-strength", "0.3MPa"]
+    base += ["--modulus", "2.4MPa", "--radius", "0.5mm", "--work-of-adhesion", "50mJ/m2"]
+    base += ["--fit", "never", "--refine", "none", "--hedge", "0", "--fallback", "0"]
+    base += ["--no-verify"]
+    out = tmp_path / "auto"
+    assert main([*base, "--area", "auto", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "chose area =" in text
+    data = json.loads((out / "design.json").read_text())
+    assert data["target"]["scale"]["variable"] == "area"
+    assert data["target"]["friction"]["work_of_adhesion_j_m2"] == pytest.approx(W_J)
+    assert "adhesion=" in data["model"]
+    fixed = tmp_path / "fixed"
+    assert main([*base, "--area", "1cm2", "--out", str(fixed)]) == 2
+    said = capsys.readouterr()
+    assert "not reachable at area 1 cm^2" in said.out and "w = 50 mJ/m^2" in said.out
+    assert "reachable with an area of" in said.out
+    assert not (fixed / "design.json").exists()
