@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import torch
@@ -337,89 +336,3 @@ def jkr_path(
     top = np.maximum.accumulate(np.where(loading, p, -np.inf))
     on_branch = loading & (p >= top) & (p > 0)
     return AdhesivePath(np.concatenate([up, down]), p, np.array(alpha), loading, on_branch)
-
-
-@dataclass(frozen=True)
-class AdhesiveCheck:
-    """An adhesive design against the JKR-limit BEM at the loads a rising force reaches.
-
-    p_star: (K,) the BEM's load-controlled states' P*; alpha_bem, alpha_model,
-    alpha_target: (K,) there (target interpolated, NaN beyond its range); error: relative
-    L2 of BEM against target over the target's range; model_error: the model against the
-    BEM; grid: M; seconds: the BEM's wall time.
-    """
-
-    p_star: np.ndarray
-    alpha_bem: np.ndarray
-    alpha_model: np.ndarray
-    alpha_target: np.ndarray
-    error: float
-    model_error: float
-    grid: int
-    seconds: float
-
-    def note(self) -> str:
-        """One line for a design's notes."""
-        return (
-            f"adhesive BEM (JKR limit, {self.grid}^2, {self.p_star.size} loads): error to the "
-            f"target {100 * self.error:.3g} %, model against BEM {100 * self.model_error:.3g} %"
-        )
-
-
-def check_adhesive(
-    design: Any,
-    model: Any,
-    target_p: np.ndarray,
-    target_alpha: np.ndarray,
-    *,
-    grid: int,
-    approaches: int = 16,
-    device: torch.device | str = "cpu",
-) -> AdhesiveCheck:
-    """Load ``design`` (a physics.Design) by approach to Delta_max in the JKR-limit BEM with
-    the work of adhesion of ``model`` (a ForwardModel with adhesion > 0), keep the states
-    a rising force reaches, and compare them with the target (P* (T,), alpha (T,)) and the
-    model at the same P*."""
-    import time
-
-    from metainterface.validation.heightmap import height_map
-
-    if not model.adhesion:
-        raise MetainterfaceError("check_adhesive needs a model with adhesion > 0")
-    s = design.settings
-    hm = height_map(design, grid)
-    start = time.perf_counter()
-    work = model.adhesion * s.e_star * s.radius  # w [E* length] in the cell's units
-    path = jkr_path(
-        hm.heights,
-        hm.cell_side,
-        work,
-        np.linspace(0.0, s.delta_max, approaches + 1)[1:],
-        device=device,
-    )
-    seconds = time.perf_counter() - start
-    p = path.p_star[path.on_branch]
-    bem = path.alpha[path.on_branch]
-    gamma, h = design.tensors(torch.float64)
-    with torch.no_grad():
-        mod = model.alpha_at_loads(gamma, h, s, torch.as_tensor(p)[None])[0].numpy()
-    tp = np.asarray(target_p, dtype=np.float64)
-    ta = np.interp(p, tp, np.asarray(target_alpha, dtype=np.float64))
-    inside = p <= tp[-1]
-    ta = np.where(inside, ta, np.nan)
-
-    def rel(a: np.ndarray, b: np.ndarray) -> float:
-        if not a.size:
-            return math.nan
-        return float(np.linalg.norm(a - b) / np.linalg.norm(b))
-
-    return AdhesiveCheck(
-        p_star=p,
-        alpha_bem=bem,
-        alpha_model=mod,
-        alpha_target=ta,
-        error=rel(bem[inside], ta[inside]),
-        model_error=rel(mod, bem),
-        grid=int(grid),
-        seconds=seconds,
-    )
