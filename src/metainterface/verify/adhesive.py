@@ -21,6 +21,7 @@ the check runs there whatever ``Verify.engine`` says (a note says so).
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 import torch
@@ -29,7 +30,6 @@ from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
-from metainterface.verify.check import BemCheck, Verify, curve_error
 
 #: Approaches of the path per load asked for (``Verify.loads``): some states of the path
 #: are not on the rising-force branch (just after a snap-in the force dips below its running
@@ -51,11 +51,32 @@ def approaches(design: Design, model: ForwardModel, top: float, k: int) -> np.nd
     return end * np.arange(1, k + 1) / k
 
 
-def adhesive_check(
-    design: Design, target: Target, settings: Verify, model: ForwardModel
-) -> BemCheck:
-    """``design`` (made with the adhesive ``model``) in the JKR-limit BEM against ``target``
-    under a rising force. Raises MetainterfaceError where no state of the path lies in the
+@dataclass(frozen=True)
+class AdhesiveSolved:
+    """The adhesive check's BEM path at the states a rising force reaches inside the
+    target's range: p_star, alpha_bem, alpha_model (K,); device, wall time [s], notes."""
+
+    p_star: np.ndarray
+    alpha_bem: np.ndarray
+    alpha_model: np.ndarray
+    device: str
+    seconds: float
+    notes: tuple[str, ...]
+
+
+def solve_adhesive(
+    design: Design,
+    target: Target,
+    model: ForwardModel,
+    *,
+    grid: int,
+    loads: int,
+    device: str = "auto",
+    engine: str = "torch",
+) -> AdhesiveSolved:
+    """``design`` (made with the adhesive ``model``) in the JKR-limit BEM on ``grid``^2 by
+    ``APPROACHES_PER_LOAD * loads`` approaches; ``engine``: the one asked for (noted when it
+    is not torch). Raises MetainterfaceError where no state of the path lies in the
     target's range."""
     from metainterface._device import resolve_device
     from metainterface.validation.adhesive_bem import jkr_path
@@ -64,14 +85,13 @@ def adhesive_check(
     if not model.adhesion:
         raise MetainterfaceError("the adhesive check needs a model with adhesion > 0")
     s = design.settings
-    grid = settings.grid_for(s)
     top = min(target.p_star_max, model.model_curve(design).p_star_max)
-    deltas = approaches(design, model, top, APPROACHES_PER_LOAD * settings.loads)
-    device = resolve_device(settings.device)
+    deltas = approaches(design, model, top, APPROACHES_PER_LOAD * loads)
+    dev = resolve_device(device)
     hm = height_map(design, grid)
     t0 = time.perf_counter()
     work = model.adhesion * s.e_star * s.radius  # w [E* length] in the cell's units
-    path = jkr_path(hm.heights, hm.cell_side, work, deltas, device=device)
+    path = jkr_path(hm.heights, hm.cell_side, work, deltas, device=dev)
     seconds = time.perf_counter() - t0
     keep = path.on_branch & (path.p_star <= target.p_star_max * (1 + 1e-9))
     if not keep.any():
@@ -80,35 +100,19 @@ def adhesive_check(
             f"(up to P* = {float(path.p_star.max()):.3g}); check on a finer grid"
         )
     p = path.p_star[keep]
-    bem = path.alpha[keep]
     gamma, h = design.tensors(torch.float64)
     with torch.no_grad():
         mod = model.alpha_at_loads(gamma, h, s, torch.as_tensor(p)[None])[0].numpy()
-    alpha_t = np.interp(p, target.p_star, target.alpha)
     notes = [
         f"adhesive BEM: the JKR limit (Pohrt-Popov criterion) under a rising force, "
         f"w = {model.adhesion:.3g} E* R, {int(keep.sum())} of {deltas.size} approaches on "
         "the rising branch"
     ]
-    if settings.engine != "torch":
-        notes.append(f"the adhesive check runs in the torch engine, not {settings.engine}")
+    if engine != "torch":
+        notes.append(f"the adhesive check runs in the torch engine, not {engine}")
     if p[-1] < top * (1 - 0.25):
         notes.append(
             f"the adhesive BEM's rising branch reaches P* = {p[-1]:.4g} in the target's "
             f"range, short of {top:.4g}: the check stops there"
         )
-    return BemCheck(
-        p_star=p,
-        alpha_bem=bem,
-        alpha_model=mod,
-        alpha_target=alpha_t,
-        bem_error=curve_error(bem, alpha_t),
-        model_error=curve_error(mod, alpha_t),
-        grid=grid,
-        engine="torch",
-        device=str(device),
-        seconds=seconds,
-        max_error=settings.max_error,
-        notes=tuple(notes),
-        adhesion=float(model.adhesion),
-    )
+    return AdhesiveSolved(p, path.alpha[keep], mod, str(dev), seconds, tuple(notes))

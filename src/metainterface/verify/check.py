@@ -322,9 +322,7 @@ def bem_check(
     settings = settings or Verify()
     fm = get_model(model)
     if fm.adhesion:
-        from metainterface.verify.adhesive import adhesive_check
-
-        return adhesive_check(design, target, settings, fm)
+        return _adhesive_check(design, target, settings, fm)
     loads = check_loads(design, target, fm, settings.loads)
     solved = solve_bem(design, loads, settings, fm)
     alpha_t = np.interp(loads, target.p_star, target.alpha)
@@ -347,4 +345,39 @@ def bem_check(
         seconds=solved.seconds,
         max_error=settings.max_error,
         notes=notes,
+    )
+
+
+def _adhesive_check(
+    design: Design, target: Target, settings: Verify, model: ForwardModel
+) -> BemCheck:
+    """``bem_check`` of a design made with an adhesive model: the JKR-limit BEM under a
+    rising force, at the states its path reaches (``verify.adhesive``)."""
+    from metainterface.verify.adhesive import solve_adhesive
+
+    grid = settings.grid_for(design.settings)
+    solved = solve_adhesive(
+        design,
+        target,
+        model,
+        grid=grid,
+        loads=settings.loads,
+        device=settings.device,
+        engine=settings.engine,
+    )
+    alpha_t = np.interp(solved.p_star, target.p_star, target.alpha)
+    return BemCheck(
+        p_star=solved.p_star,
+        alpha_bem=solved.alpha_bem,
+        alpha_model=solved.alpha_model,
+        alpha_target=alpha_t,
+        bem_error=curve_error(solved.alpha_bem, alpha_t),
+        model_error=curve_error(solved.alpha_model, alpha_t),
+        grid=grid,
+        engine="torch",
+        device=solved.device,
+        seconds=solved.seconds,
+        max_error=settings.max_error,
+        notes=solved.notes,
+        adhesion=float(model.adhesion),
     )
