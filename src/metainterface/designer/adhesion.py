@@ -146,24 +146,3 @@ def adhesion_notes(
         f"{100 * change[0]:+.3g} % at {fn[0]:.3g} N and {zero * tau * area:.3g} N at zero "
         "load; design with --work-of-adhesion if the part's interface adheres",
     )
-
-
-def adhesive_bem_check(result: Any, checks: Any) -> Any:
-    """``result`` with the note of its check in the adhesive BEM (JKR limit, the grid of
-    ``checks``, a ``Verify``): adhesive designs are checked, not yet corrected."""
-    import dataclasses as dc
-
-    from metainterface._device import resolve_device
-    from metainterface.validation.adhesive_bem import check_adhesive
-
-    grid = checks.grid_for(result.design.settings)
-    device = resolve_device(checks.device)
-    check = check_adhesive(
-        result.design,
-        result.model,
-        result.target.p_star,
-        result.target.alpha,
-        grid=grid,
-        device=device,
-    )
-    return dc.replace(result, notes=(*result.notes, check.note()))

@@ -18,7 +18,6 @@ from metainterface._files.provenance import current_command
 from metainterface._threads import uses_threads
 from metainterface.designer.adhesion import (
     adhesion_notes,
-    adhesive_bem_check,
     given_adhesion,
     model_for_targets,
 )
@@ -183,9 +182,6 @@ def design(
     if not isinstance(full_target, bool):
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
     checks = as_verify(verify, device)
-    adhesive_checks = None
-    if checks is not None and fm.adhesion:  # checked in the adhesive BEM, not corrected
-        adhesive_checks, checks = checks, None
     if checks is not None:  # a bad grid or device fails now, not after the design
         checks.ready(settings or CellSettings())
     limit = _limit(max_pressure, modulus)
@@ -235,8 +231,6 @@ def design(
         results = [_robust_stats(r, perturb, seed, dev) for r in results]
     if step is not None:
         results = [_printable_record(r, radius_m) for r in results]
-    if adhesive_checks is not None:
-        results = [adhesive_bem_check(r, adhesive_checks) for r in results]
     if checks is not None:
         results = _verify_all(
             results, checks, extra_loss, refine_settings, step, perturb, limit, modulus

@@ -25,14 +25,17 @@ that; the stress of the edge element is instead c_e K_I / sqrt(dx), c_e a consta
 the discretisation. The mesh-dependent criterion: a point in contact comes off where its
 tension exceeds sigma_c = c_e sqrt(2 E* w / dx), and a point comes into contact where the
 surfaces overlap, or, beside the contact, where the gap is below the opening of a critical
-crack one spacing behind its edge, c_g sqrt(2 E* w dx) / E* (so the edge sits where the
-energy released equals w on loading too: the reversible JKR branch that the forward model
-follows; a point that came off in a solve closes again only by overlap, so the updates
-cannot cycle). At each mean gap the bonded problem (g = 0 on the contact set C, p = 0
-off it) is linear and solved by conjugate gradients; C is updated by the two rules until
-it no longer changes. c_e (``EDGE_FACTOR``) is calibrated for this kernel on a flat punch
-(Kendall: detachment at F = sqrt(8 pi w E* a^3)), see ``edge_factor``; the JKR sphere is
-then an independent check.
+crack half a spacing behind its edge, c_g sqrt(2 E* w dx) / E*, c_g = 2 / sqrt(pi) from
+the crack's opening profile (so the edge sits where the energy released equals w on
+loading too: the reversible JKR branch that the forward model follows; a point that came
+off in a solve closes again only by overlap, so the updates cannot cycle). At each mean
+gap the bonded problem (g = 0 on the contact set C, p = 0 off it) is linear and solved by
+conjugate gradients; C is updated by the two rules until it no longer changes. c_e
+(``EDGE_FACTOR``) is calibrated for this kernel on a flat punch (it comes off at Kendall's
+F = sqrt(8 pi w E* a^3)), see ``pull_off_factor``, and c_g follows from the crack's
+opening; the JKR sphere is then an independent check: a Hertz asperity's contact fraction
+against the JKR a(P) at each compressive force, loading and unloading, falls with the grid
+(the edge is placed to a fraction of a spacing; benchmarks/results/adhesion.md).
 
 Everything is float64 and batched over a leading axis B of cells of one grid size and
 side (``heights`` (B, M, M)); no loops over grid points.
@@ -42,7 +45,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import torch
@@ -51,15 +53,26 @@ from torch import Tensor
 from metainterface.errors import MetainterfaceError
 from metainterface.validation.torch_bem import displacement, unit_kernel
 
-#: The edge-element factor c_e of the JKR (Pohrt-Popov) criterion for this kernel: the
-#: tension of the most loaded edge point of a bonded flat punch is c_e K_I / sqrt(dx)
-#: (``edge_factor`` measures it; tests/validation/test_adhesive_bem.py checks it).
-EDGE_FACTOR = 1.035
-#: The closing factor c_g: the gap beside the edge of a bonded flat punch is at least
-#: c_g K_I sqrt(dx) / E* (the nearest neighbours; 0.94-0.99 on grids 128-256). A point
-#: beside the contact whose gap is below c_g K_c sqrt(dx), K_c = sqrt(2 E* w), lies at an
-#: edge whose stress intensity is below the critical one: the crack closes there.
-CLOSING_FACTOR = 1.25
+#: The edge-element factor c_e of the JKR (Pohrt-Popov) criterion for this kernel: a bonded
+#: flat punch pulled through ``solve_jkr`` comes off at Kendall's force with it
+#: (``pull_off_factor``: 1.016-1.027, mean 1.021, over six sub-pixel radii a / dx = 20-32 at
+#: 256^2, the resolution of a check; it rises slowly with a / dx, 1.006 at 6-12, 1.011 at
+#: 10-25). It was 1.035, the most tensile point of the untrimmed disc (``edge_factor``): the
+#: first point to come off, after which the trimmed edge holds a few % more, so a receding
+#: edge lagged (a Hertz asperity's unloading read +3.35 % at 256^2).
+EDGE_FACTOR = 1.021
+#: The closing factor c_g, from the JKR crack's opening: at a sharp edge of stress intensity K
+#: the gap a distance s outside it is sqrt(8 / pi) K sqrt(s) / E* (Kendall's flat punch,
+#: the first term of arcsin near the edge). A point beside the contact closes when its gap
+#: is below that opening at s = dx / 2 with K = K_c = sqrt(2 E* w), the opening of a
+#: critical edge half a spacing away, c_g = sqrt(8 / pi) sqrt(1 / 2) = 2 / sqrt(pi): the
+#: edge of a growing contact then passes a point as the JKR edge passes its pixel's middle,
+#: so the pixel count follows pi a^2 on loading. (It was 1.25, about the mean gap of a
+#: bonded flat punch's neighbours, 1.21 K sqrt(dx): with it a point closed whose gap is
+#: above the critical opening, the loading edge ran ahead of K_c, and at the lowest loads,
+#: where the contact's K sets alpha (4 % of alpha per % of K at P = 0), a Hertz asperity
+#: read +3.8 % at 512^2; benchmarks/results/adhesion.md.)
+CLOSING_FACTOR = 2.0 / math.sqrt(math.pi)
 #: Conjugate-gradient iterations at most per solve, and the relative residual aimed at.
 MAX_ITER = 5000
 TOLERANCE = 1e-10
@@ -272,9 +285,11 @@ def solve_jkr(
 
 
 def edge_factor(grid: int = 256, radius_cells: float = 0.125) -> float:
-    """Measure c_e: a bonded flat punch of radius a = radius_cells L on a grid of M points,
-    its most tensile edge point against K_I = F / (2 sqrt(pi a^3)) (Kendall), a from the
-    punch's pixel count. Returns max |p_edge| sqrt(dx) / K_I."""
+    """The first point to come off: a bonded flat punch of radius a = radius_cells L on a
+    grid of M points, its most tensile edge point against K_I = F / (2 sqrt(pi a^3))
+    (Kendall), a from the punch's pixel count. Returns max |p_edge| sqrt(dx) / K_I: 1.02-1.06,
+    mean 1.036, over 13 radii at 256^2, above ``EDGE_FACTOR`` since the trimmed edge holds
+    more than the untrimmed disc's most tensile point (``pull_off_factor``)."""
     side = 1.0
     dx = side / grid
     x = (np.arange(grid) - grid / 2) * dx
@@ -289,6 +304,42 @@ def edge_factor(grid: int = 256, radius_cells: float = 0.125) -> float:
     a = math.sqrt(disc.sum() * dx * dx / math.pi)
     k_i = abs(force) / (2.0 * math.sqrt(math.pi * a**3))
     return float(p.abs().amax()) * math.sqrt(dx) / k_i
+
+
+def pull_off_factor(grid: int = 128, radius_cells: float = 0.1, step: float = 0.002) -> float:
+    """Calibrate c_e on the observable: a flat punch of radius a = radius_cells L (a disc of
+    grid points), bonded, pulled off through ``solve_jkr`` itself with c_e = 1 in steps of
+    ``step`` of the pull at which Kendall's K_I = F / (2 sqrt(pi a^3)) reaches K_c. Its
+    points come off one by one (the most tensile first, the edge trimmed) until the punch
+    lets go; the largest K_I of a stable state, a from its own pixel count, is c_e = 1's
+    detachment K. The thresholds scale with c_e, so c_e = K_c / that K makes the punch come
+    off at Kendall's force. Returns it."""
+    side, work = 1.0, 1e-4
+    dx = side / grid
+    x = (np.arange(grid) - grid / 2) * dx
+    disc = np.hypot(*np.meshgrid(x, x, indexing="ij")) < radius_cells * side
+    z = torch.as_tensor(np.where(disc, 0.0, -1.0))[None]
+    contact = torch.as_tensor(disc)[None]
+    k_c = math.sqrt(2.0 * work)
+
+    def k_of(p: Tensor, n: float) -> float:
+        a = math.sqrt(n * dx * dx / math.pi)
+        return abs(float(p.sum())) * dx * dx / (2.0 * math.sqrt(math.pi * a**3))
+
+    fwd = forward_kernel(grid, side, z.device)
+    unit, _ = _bonded(z, -torch.ones(1, 1, 1, dtype=z.dtype), contact, fwd, z * 0, 1e-12, 10000)
+    pull = k_c / k_of(unit, disc.sum())  # the pull at which the bonded punch has K_c
+    z_bar = -float(z.mean())
+    n0, k_max, pressure = float(disc.sum()), 0.0, None
+    for s in np.arange(0.8, 1.3, step):
+        target = torch.tensor([z_bar + s * pull], dtype=z.dtype)
+        sol = solve_jkr(z, side, target, work, contact=contact, pressure=pressure, edge=1.0)
+        contact, pressure = sol.contact, sol.pressure
+        n = float(contact.sum())
+        if n < 0.5 * n0:
+            break
+        k_max = max(k_max, k_of(pressure, n))
+    return k_c / k_max
 
 
 @dataclass(frozen=True)
@@ -337,89 +388,3 @@ def jkr_path(
     top = np.maximum.accumulate(np.where(loading, p, -np.inf))
     on_branch = loading & (p >= top) & (p > 0)
     return AdhesivePath(np.concatenate([up, down]), p, np.array(alpha), loading, on_branch)
-
-
-@dataclass(frozen=True)
-class AdhesiveCheck:
-    """An adhesive design against the JKR-limit BEM at the loads a rising force reaches.
-
-    p_star: (K,) the BEM's load-controlled states' P*; alpha_bem, alpha_model,
-    alpha_target: (K,) there (target interpolated, NaN beyond its range); error: relative
-    L2 of BEM against target over the target's range; model_error: the model against the
-    BEM; grid: M; seconds: the BEM's wall time.
-    """
-
-    p_star: np.ndarray
-    alpha_bem: np.ndarray
-    alpha_model: np.ndarray
-    alpha_target: np.ndarray
-    error: float
-    model_error: float
-    grid: int
-    seconds: float
-
-    def note(self) -> str:
-        """One line for a design's notes."""
-        return (
-            f"adhesive BEM (JKR limit, {self.grid}^2, {self.p_star.size} loads): error to the "
-            f"target {100 * self.error:.3g} %, model against BEM {100 * self.model_error:.3g} %"
-        )
-
-
-def check_adhesive(
-    design: Any,
-    model: Any,
-    target_p: np.ndarray,
-    target_alpha: np.ndarray,
-    *,
-    grid: int,
-    approaches: int = 16,
-    device: torch.device | str = "cpu",
-) -> AdhesiveCheck:
-    """Load ``design`` (a physics.Design) by approach to Delta_max in the JKR-limit BEM with
-    the work of adhesion of ``model`` (a ForwardModel with adhesion > 0), keep the states
-    a rising force reaches, and compare them with the target (P* (T,), alpha (T,)) and the
-    model at the same P*."""
-    import time
-
-    from metainterface.validation.heightmap import height_map
-
-    if not model.adhesion:
-        raise MetainterfaceError("check_adhesive needs a model with adhesion > 0")
-    s = design.settings
-    hm = height_map(design, grid)
-    start = time.perf_counter()
-    work = model.adhesion * s.e_star * s.radius  # w [E* length] in the cell's units
-    path = jkr_path(
-        hm.heights,
-        hm.cell_side,
-        work,
-        np.linspace(0.0, s.delta_max, approaches + 1)[1:],
-        device=device,
-    )
-    seconds = time.perf_counter() - start
-    p = path.p_star[path.on_branch]
-    bem = path.alpha[path.on_branch]
-    gamma, h = design.tensors(torch.float64)
-    with torch.no_grad():
-        mod = model.alpha_at_loads(gamma, h, s, torch.as_tensor(p)[None])[0].numpy()
-    tp = np.asarray(target_p, dtype=np.float64)
-    ta = np.interp(p, tp, np.asarray(target_alpha, dtype=np.float64))
-    inside = p <= tp[-1]
-    ta = np.where(inside, ta, np.nan)
-
-    def rel(a: np.ndarray, b: np.ndarray) -> float:
-        if not a.size:
-            return math.nan
-        return float(np.linalg.norm(a - b) / np.linalg.norm(b))
-
-    return AdhesiveCheck(
-        p_star=p,
-        alpha_bem=bem,
-        alpha_model=mod,
-        alpha_target=ta,
-        error=rel(bem[inside], ta[inside]),
-        model_error=rel(mod, bem),
-        grid=int(grid),
-        seconds=seconds,
-    )

@@ -187,6 +187,12 @@ class BemCheck:
         Wall time of the BEM solve [s].
     max_error : float
         The threshold the design is trusted within.
+    notes : tuple of str
+        What the check says beside its figures.
+    adhesion : float
+        The work of adhesion w [E* R] of an adhesive design's check (0: adhesionless): its
+        loads are the states of the JKR-limit BEM that a rising force reaches
+        (``verify.adhesive``).
     """
 
     p_star: np.ndarray
@@ -201,6 +207,7 @@ class BemCheck:
     seconds: float
     max_error: float = 0.02
     notes: tuple[str, ...] = field(default=())
+    adhesion: float = 0.0
 
     @property
     def ok(self) -> bool:
@@ -229,6 +236,7 @@ class BemCheck:
             "alpha_model": self.alpha_model.tolist(),
             "alpha_target": self.alpha_target.tolist(),
             **({"notes": list(self.notes)} if self.notes else {}),
+            **({"adhesion": self.adhesion} if self.adhesion else {}),
         }
 
     def __repr__(self) -> str:
@@ -307,10 +315,14 @@ def bem_check(
 ) -> BemCheck:
     """Solve ``design`` in BEM at ``settings.loads`` loads and measure it against ``target``.
 
-    model: the forward model the design was made with (its error is reported beside).
+    model: the forward model the design was made with (its error is reported beside). An
+    adhesive model's design is checked in the JKR-limit BEM under a rising force, at the
+    states the path reaches (``verify.adhesive``).
     """
     settings = settings or Verify()
     fm = get_model(model)
+    if fm.adhesion:
+        return _adhesive_check(design, target, settings, fm)
     loads = check_loads(design, target, fm, settings.loads)
     solved = solve_bem(design, loads, settings, fm)
     alpha_t = np.interp(loads, target.p_star, target.alpha)
@@ -333,4 +345,39 @@ def bem_check(
         seconds=solved.seconds,
         max_error=settings.max_error,
         notes=notes,
+    )
+
+
+def _adhesive_check(
+    design: Design, target: Target, settings: Verify, model: ForwardModel
+) -> BemCheck:
+    """``bem_check`` of a design made with an adhesive model: the JKR-limit BEM under a
+    rising force, at the states its path reaches (``verify.adhesive``)."""
+    from metainterface.verify.adhesive import solve_adhesive
+
+    grid = settings.grid_for(design.settings)
+    solved = solve_adhesive(
+        design,
+        target,
+        model,
+        grid=grid,
+        loads=settings.loads,
+        device=settings.device,
+        engine=settings.engine,
+    )
+    alpha_t = np.interp(solved.p_star, target.p_star, target.alpha)
+    return BemCheck(
+        p_star=solved.p_star,
+        alpha_bem=solved.alpha_bem,
+        alpha_model=solved.alpha_model,
+        alpha_target=alpha_t,
+        bem_error=curve_error(solved.alpha_bem, alpha_t),
+        model_error=curve_error(solved.alpha_model, alpha_t),
+        grid=grid,
+        engine="torch",
+        device=solved.device,
+        seconds=solved.seconds,
+        max_error=settings.max_error,
+        notes=solved.notes,
+        adhesion=float(model.adhesion),
     )

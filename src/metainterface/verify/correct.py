@@ -33,6 +33,7 @@ model: no extra BEM solve.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -104,7 +105,8 @@ def shifted_target(
     model_alpha = check.alpha_model if alpha_model is None else alpha_model
     defect = model_alpha - check.alpha_bem
     p = np.concatenate([[0.0], check.p_star])
-    d = np.concatenate([[0.0], defect])
+    # an adhesive cell has a contact at zero load (snap-in): its defect is held down to it
+    d = np.concatenate([[defect[0] if check.adhesion else 0.0], defect])
     alpha = target.alpha + step * np.interp(target.p_star, p, d)
     return target.p_star, np.maximum(alpha, 0.0)
 
@@ -193,6 +195,19 @@ def alpha_at(design: Design, model: ForwardModel, p_star: np.ndarray) -> np.ndar
     return np.interp(p_star, curve.p_star, curve.alpha)
 
 
+def with_adhesion(inner: ForwardModel, model: ForwardModel) -> ForwardModel:
+    """The correction's model ``inner`` with the adhesion of the design's ``model`` (an
+    adhesive design is corrected on an adhesive model); ``model`` itself where ``inner``
+    takes no adhesion."""
+    if not model.adhesion or inner.adhesion == model.adhesion:
+        return inner
+    if dataclasses.is_dataclass(inner) and "adhesion" in {
+        f.name for f in dataclasses.fields(inner)
+    }:
+        return dataclasses.replace(inner, adhesion=model.adhesion)
+    return model
+
+
 def correct(
     design: Design,
     target: Target,
@@ -210,11 +225,12 @@ def correct(
     are those the design was refined with (the Hertz baseline keeps gamma = 2, a design on a
     printer's layers keeps its heights; neither is designed afresh). model: the one the design
     was made with (``check``'s, and the one the returned checks and model errors are on);
-    the re-refinement runs on ``settings.inner`` (None: this one).
+    the re-refinement runs on ``settings.inner`` (None: this one), with the adhesion of
+    ``model`` where it has one (an adhesive design is checked in the JKR-limit BEM).
     """
     settings = settings or Verify()
     fm = get_model(model)
-    inner = fm if settings.inner is None else get_model(settings.inner)
+    inner = fm if settings.inner is None else with_adhesion(get_model(settings.inner), fm)
 
     def inner_alpha(d: Design, c: BemCheck) -> np.ndarray | None:
         return None if inner == fm else alpha_at(d, inner, c.p_star)

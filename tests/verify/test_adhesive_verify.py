@@ -1,0 +1,110 @@
+"""Adhesive designs checked and corrected in the adhesive (JKR-limit) BEM, as a user calls
+it (issue 38): the check compares under a rising force, the correction runs, design.json
+records it, and the command line's exit status follows the BEM error."""
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+import torch
+
+import metainterface as mi
+from metainterface.cli import main
+from metainterface.physics import CellSettings
+
+# PDMS on glass: w = 50 mJ/m^2, E* = 2.4 MPa, R = 0.5 mm
+W = 0.05 / (2.4e6 * 0.5e-3)
+QUICK = mi.Effort(refine=False, seed=0)
+
+
+@pytest.fixture(scope="module")
+def sticky_target():
+    """The loading curve of a held-back adhesive cell (16 loads from zero)."""
+    s = CellSettings()
+    rng = np.random.default_rng(3)
+    g = rng.uniform(1.8, 4.0, 9)
+    h = rng.uniform(0, 0.6, 9) * s.delta_max
+    h -= h.min()
+    model = mi.Independent(adhesion=W)
+    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
+    with torch.no_grad():
+        p_max = float(model.sweep(gt, ht, s).p_star[0, -1])
+        p = np.linspace(0, 0.9 * p_max, 16)
+        p[0] = 1e-12 * p_max
+        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
+    return mi.Target(p_star=p, alpha=a, name="sticky")
+
+
+@pytest.fixture(scope="module")
+def corrected(sticky_target):
+    model = mi.Independent(adhesion=W)
+    checks = mi.Verify(grid=48, loads=4, correct=True, iterations=1, restart=False, inner=None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return mi.design(sticky_target, model=model, verify=checks, effort=QUICK)
+
+
+def test_an_adhesive_design_is_checked_under_a_rising_force(corrected, sticky_target):
+    check = corrected.bem
+    assert check is not None and check.adhesion == pytest.approx(W)
+    # the loads are the BEM path's states a rising force reaches, inside the target's range
+    assert check.p_star.size >= 2 and np.all(np.diff(check.p_star) > 0)
+    assert check.p_star[0] > 0 and check.p_star[-1] <= sticky_target.p_star_max
+    # the model is compared at those loads under load control (its own loading curve)
+    gamma, h = corrected.design.tensors(torch.float64)
+    with torch.no_grad():
+        model = corrected.model.alpha_at_loads(
+            gamma, h, corrected.design.settings, torch.as_tensor(check.p_star)[None]
+        )[0].numpy()
+    np.testing.assert_allclose(check.alpha_model, model, rtol=1e-12)
+    np.testing.assert_allclose(
+        check.alpha_target, np.interp(check.p_star, sticky_target.p_star, sticky_target.alpha)
+    )
+    # adhesion in the BEM: at the lowest load the contact is larger than without it (snap-in)
+    plain = (
+        mi.Independent()
+        .alpha_at_loads(
+            gamma, h, corrected.design.settings, torch.as_tensor(check.p_star[:1])[None]
+        )[0, 0]
+        .item()
+    )
+    assert check.alpha_bem[0] > 1.5 * plain
+    err = np.linalg.norm(check.alpha_bem - check.alpha_target) / np.linalg.norm(check.alpha_target)
+    assert check.bem_error == pytest.approx(err, rel=1e-12)
+    assert any(n.startswith("adhesive BEM: the JKR limit") for n in check.notes)
+
+
+def test_an_adhesive_design_is_corrected_and_recorded(corrected, tmp_path):
+    assert corrected.bem_before is not None and len(corrected.corrections) == 1
+    assert corrected.bem_before.adhesion == pytest.approx(W)
+    # a correction is kept only where its BEM error fell
+    assert corrected.bem.bem_error <= corrected.bem_before.bem_error
+    assert corrected.corrections[0].accepted == (corrected.bem is not corrected.bem_before)
+    corrected.save(tmp_path)
+    block = json.loads((tmp_path / "design.json").read_text())["bem_check"]
+    assert block["adhesion"] == pytest.approx(W)
+    assert block["bem_error"] == pytest.approx(corrected.bem.bem_error)
+    assert block["uncorrected"]["bem_error"] == pytest.approx(corrected.bem_before.bem_error)
+    assert len(block["corrections"]) == 1
+
+
+def test_cli_exit_status_follows_the_adhesive_bem_error(sticky_target, tmp_path, capsys):
+    csv = tmp_path / "sticky.csv"
+    pairs = zip(sticky_target.p_star.tolist(), sticky_target.alpha.tolist(), strict=True)
+    rows = "\n".join(f"{p!r},{a!r}" for p, a in pairs)
+    csv.write_text("p_star,alpha\n" + rows + "\n")
+    args = ["design", "--target-csv", str(csv), "--modulus", "2.4MPa", "--radius", "0.5mm"]
+    args += ["--work-of-adhesion", "50mJ/m2", "--refine", "none", "--verify-grid", "48"]
+    args += ["--verify-loads", "4", "--no-correct"]
+    out = tmp_path / "tight"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main([*args, "--out", str(out), "--max-bem-error", "0.001"]) == 3
+        assert "is above --max-bem-error 0.001 %" in capsys.readouterr().out
+        block = json.loads((out / "design.json").read_text())["bem_check"]
+        assert block["ok"] is False and block["adhesion"] == pytest.approx(W)
+        loose = tmp_path / "loose"
+        assert main([*args, "--out", str(loose), "--max-bem-error", "100"]) == 0
+    block = json.loads((loose / "design.json").read_text())["bem_check"]
+    assert block["ok"] is True and block["bem_error"] < 1
