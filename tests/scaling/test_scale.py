@@ -72,7 +72,7 @@ def test_design_scale_finds_an_area_that_designs_the_law(law_csv):
         radius="0.5mm",
         area="2cm2..20cm2",
         verify=False,
-        # a short search: the law is a cell's own curve, effort=mi.Effort(hedge=2, fallback=0)
+        effort=mi.Effort(hedge=2, fallback=0),  # a short search: the law is a cell's own curve
     )
     sc = r.target.meta["scale"]
     assert sc["variable"] == "area" and 2e-4 <= sc["value"] <= 20e-3

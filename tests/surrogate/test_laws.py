@@ -190,6 +190,8 @@ def test_the_cli_says_which_reading_of_a_law_made_the_zero_shot_design(tmp_path,
     out = tmp_path / "d"
     args = ["design", "--friction-csv", str(csv), "--shear-strength", "0.25MPa", "--modulus"]
     args += ["2MPa", "--radius", "0.5mm", "--area", "30cm2", "--no-verify", "--out", str(out)]
+    # the zero-shot reading is made before any search: none is run after it
+    args += ["--refine", "none", "--hedge", "0", "--fallback", "0"]
     assert main(args) == 0
     said = capsys.readouterr().out
     record = json.loads((out / "design.json").read_text())
