@@ -45,7 +45,8 @@ def calibrate_csv(
 
     Either a sphere test (``sphere_radius``: :func:`calibrate_sphere`) or a made design's
     (``design``, a design.json: :func:`calibrate_design`), whose physical block gives R and
-    the patch's nominal area; ``area`` and ``radius`` give or override them.
+    the patch's nominal area (``area`` and ``radius`` give or override them) and whose
+    "model" names the forward model (independent or interacting; none: independent).
     """
     from metainterface.units.law_file import read_friction_csv
     from metainterface.units.quantities import parse_area, parse_length, parse_pressure
@@ -82,6 +83,8 @@ def calibrate_csv(
         )
     r = parse_length(radius, option="--radius") if radius is not None else block["radius_m"]
     a = parse_area(area, option="--area") if area is not None else block["area_m2"]
+    # the forward model the design was made with (a design.json without one: the paper's)
+    model = d.extras.get("model") or "independent"
     return calibrate_design(
         law.normal_force,
         law.friction_force,
@@ -90,4 +93,5 @@ def calibrate_csv(
         area=float(a),
         radius=float(r),
         source=str(path),
+        model=model,
     )

@@ -1,8 +1,8 @@
 """Calibrate the interface from a friction test of a made design: tau and w (issue 38).
 
 The design's cell (gammas and heights of its design.json; R and the patch's nominal area A
-from its physical block) under the adhesive model in load control
-(``Independent(adhesion=w / (E* R))``, the curve the design was made with):
+from its physical block) under the adhesive form of the model it was made with, in load
+control (``Independent`` or ``Interacting`` with adhesion w / (E* R)):
 F_f = tau alpha(F_n / (A E*); w) A. tau enters linearly, so for each w the best tau is
 closed-form; w is found by a scan over log w, a finer one about its best, then a bounded
 1-D search. The friction jumps where an asperity snaps in at a load the test holds, so w's
@@ -13,6 +13,7 @@ drift with w over that range.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -20,6 +21,7 @@ import numpy as np
 
 from metainterface.calibration.sphere import Calibration
 from metainterface.errors import MetainterfaceError
+from metainterface.physics.models import ForwardModel, get_model
 
 #: The adhesion scanned before the 1-D search, in units of E* R (0 is tried too): the
 #: adhesive model's range up to ``ADHESION_LIMIT``, 3 points a decade; then 24 a decade
@@ -93,6 +95,20 @@ def _profile_edge(
     return 0.5 * (inner + outer)
 
 
+def adhesive_model(model: str | ForwardModel, adhesion: float) -> ForwardModel:
+    """The forward model ``model`` (a name or a ForwardModel) with adhesion w / (E* R)."""
+    base = get_model(model)
+    if not dataclasses.is_dataclass(base) or "adhesion" not in {
+        f.name for f in dataclasses.fields(base)
+    }:
+        raise MetainterfaceError(
+            f"model {base.label!r} takes no adhesion; calibrate with 'independent' or "
+            "'interacting'",
+            argument="model",
+        )
+    return dataclasses.replace(base, adhesion=adhesion)
+
+
 def design_friction(
     normal_force: np.ndarray,
     tau: float,
@@ -102,22 +118,22 @@ def design_friction(
     e_star: float,
     area: float,
     radius: float,
+    model: str | ForwardModel = "independent",
 ) -> np.ndarray:
     """F_f = tau alpha(P*) A [N] of a made design's patch at loads F_n (K,) >= 0 [N].
 
     design: a Design (its gammas and heights in units of R); e_star E* [Pa]; area: the
     patch's nominal area A [m^2]; radius R [m]; work w [J/m^2]. alpha is the adhesive
-    model's loading curve under a rising force (``Independent(adhesion=w / (E* R))``) at
-    P* = F_n / (A E*); at zero load, the state just after the cell snaps in.
+    ``model``'s loading curve under a rising force (``independent`` or ``interacting``,
+    with adhesion w / (E* R)) at P* = F_n / (A E*); at zero load, the state just after the
+    cell snaps in.
     """
     import torch
-
-    from metainterface.physics.models import Independent
 
     fn = np.asarray(normal_force, dtype=np.float64)
     p = fn / (area * e_star)
     q = np.maximum(p, 1e-12 * max(float(p.max()), 1e-300))  # zero load: after the snap-in
-    model = Independent(adhesion=work / (e_star * radius))
+    model = adhesive_model(model, work / (e_star * radius))
     g, h = design.tensors(torch.float64)
     with torch.no_grad():
         loads = torch.as_tensor(q)[None]
@@ -134,12 +150,15 @@ def calibrate_design(
     area: float,
     radius: float,
     source: str = "friction test",
+    model: str | ForwardModel = "independent",
 ) -> Calibration:
     """Fit tau and w to a friction test (K,) [N] of a made design's patch.
 
     design: the Design made; e_star E* [Pa]; area: the patch's nominal area [m^2]; radius:
-    the asperity radius R [m]. Loads must be >= 0 (the loading branch: a pull depends on
-    the path the patch came by); rows with friction <= 0 are left out; at least 3 rows.
+    the asperity radius R [m]; model: the forward model the design was made with
+    (``independent`` or ``interacting``; design.json's "model"). Loads must be >= 0 (the
+    loading branch: a pull depends on the path the patch came by); rows with friction <= 0
+    are left out; at least 3 rows.
     """
     from metainterface.physics.jkr import ADHESION_LIMIT
 
@@ -162,8 +181,13 @@ def calibrate_design(
         )
     unit = e_star * radius  # w [J/m^2] = w [E* R] * unit
 
+    adhesive_model(model, 0.0)  # a model that takes no adhesion: one line, before the fit
+
     def shape(w: float) -> np.ndarray:  # friction per unit tau, over the measured friction
-        return design_friction(fn, 1.0, w, design, e_star=e_star, area=area, radius=radius) / ff
+        f = design_friction(
+            fn, 1.0, w, design, e_star=e_star, area=area, radius=radius, model=model
+        )
+        return f / ff
 
     def best(w: float) -> tuple[float, float]:  # (tau, sum of squares) at w
         try:
@@ -214,6 +238,6 @@ def calibrate_design(
         residual_rms=float(math.sqrt(cost / fn.size)),
         radius=float(radius),
         e_star=float(e_star),
-        contact=f"the cell of {name}, JKR asperities",
+        contact=f"the cell of {name}, JKR asperities ({adhesive_model(model, 0.0).label})",
         area=float(area),
     )
