@@ -16,30 +16,15 @@ import time
 import warnings
 from pathlib import Path
 
-import numpy as np
-import torch
-
 import metainterface as mi
-from metainterface.physics import CellSettings
+from metainterface._testing import adhesive_cell_curve
 
 E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
 UNITS = dict(shear_strength="0.3MPa", modulus="2.4MPa", radius="0.5mm", fit="never")
 
 
 def law(folder: Path) -> Path:
-    s = CellSettings()
-    rng = np.random.default_rng(11)
-    g = rng.uniform(1.8, 4.0, 9)
-    h = rng.uniform(0, 0.6, 9) * s.delta_max
-    h -= h.min()
-    model = mi.Independent(adhesion=W_J / (E * R))
-    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
-    with torch.no_grad():
-        p_max = float(model.sweep(gt, ht, s, n_delta=2049).p_star[0, -1])
-        p = np.linspace(0, 0.95 * p_max, 24)
-        p[0] = 1e-12 * p_max
-        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
-    p[0] = 0.0
+    p, a = adhesive_cell_curve(W_J / (E * R))
     path = folder / "pdms.csv"
     path.write_text(
         "normal_force,friction_force\n"

@@ -25,3 +25,34 @@ def borderline_laws(
         top = lo[-1] + rng.uniform(-0.2, 1.2) * (hi[-1] - lo[-1])
         out.append((p, top * (p / p_max) ** rng.uniform(0.3, 1.2)))
     return out
+
+
+def adhesive_cell_curve(
+    adhesion: float, seed: int = 11, rows: int = 24, top: float = 0.95
+) -> tuple[np.ndarray, np.ndarray]:
+    """A held-back adhesive cell's loading curve under a rising force, (P*, alpha) (rows,).
+
+    The cell: 9 asperities of the paper's space, gamma in [1.8, 4.0] and heights in
+    [0, 0.6] Delta_max drawn with ``seed``, under ``Independent(adhesion)`` (w / (E* R)).
+    P* runs from 0 (alpha there is the state just after the cell snaps in) to ``top`` times
+    the largest pressure it reaches.
+    """
+    import torch
+
+    from metainterface.physics.cell import CellSettings
+    from metainterface.physics.models import Independent
+
+    s = CellSettings()
+    rng = np.random.default_rng(seed)
+    g = rng.uniform(1.8, 4.0, 9)
+    h = rng.uniform(0, 0.6, 9) * s.delta_max
+    h -= h.min()
+    model = Independent(adhesion=adhesion)
+    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
+    with torch.no_grad():
+        p_max = float(model.sweep(gt, ht, s, n_delta=2049).p_star[0, -1])
+        p = np.linspace(0, top * p_max, rows)
+        p[0] = 1e-12 * p_max  # the zero-load state, just above the snap-in plateau
+        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
+    p[0] = 0.0
+    return p, a

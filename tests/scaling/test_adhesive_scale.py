@@ -10,6 +10,7 @@ import pytest
 import torch
 
 import metainterface as mi
+from metainterface._testing import adhesive_cell_curve
 from metainterface.cli import main
 from metainterface.inverse.envelope import reach_violation, reachable_envelope
 from metainterface.physics import CellSettings
@@ -25,19 +26,7 @@ UNITS = dict(shear_strength="0.3MPa", modulus="2.4MPa", radius="0.5mm")
 def law_csv(tmp_path_factory):
     """A held-back adhesive cell's loading curve at 4 cm^2, as a friction law with its
     zero-load row: F_f(0) > 0."""
-    s = CellSettings()
-    rng = np.random.default_rng(11)
-    g = rng.uniform(1.8, 4.0, 9)
-    h = rng.uniform(0, 0.6, 9) * s.delta_max
-    h -= h.min()
-    model = mi.Independent(adhesion=W)
-    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
-    with torch.no_grad():
-        p_max = float(model.sweep(gt, ht, s, n_delta=2049).p_star[0, -1])
-        p = np.linspace(0, 0.95 * p_max, 24)
-        p[0] = 1e-12 * p_max  # the zero-load state, just above the snap-in plateau
-        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
-    p[0] = 0.0
+    p, a = adhesive_cell_curve(W)
     fn, ff = p * AREA * E, a * TAU * AREA
     path = tmp_path_factory.mktemp("adhesive") / "pdms.csv"
     path.write_text(

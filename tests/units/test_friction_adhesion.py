@@ -8,6 +8,7 @@ import pytest
 import torch
 
 import metainterface as mi
+from metainterface._testing import adhesive_cell_curve
 from metainterface.errors import MetainterfaceError
 from metainterface.physics import CellSettings
 from metainterface.units._lawfit import fit_law
@@ -26,19 +27,7 @@ W = W_J / (E * R)
 
 def _held_back_law(seed=11, rows=24):
     """An adhesive cell's loading curve as a friction law [N] (rows from zero load)."""
-    s = CellSettings()
-    rng = np.random.default_rng(seed)
-    g = rng.uniform(1.8, 4.0, 9)
-    h = rng.uniform(0, 0.6, 9) * s.delta_max
-    h -= h.min()
-    model = mi.Independent(adhesion=W)
-    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
-    with torch.no_grad():
-        p_max = float(model.sweep(gt, ht, s, n_delta=2049).p_star[0, -1])
-        p = np.linspace(0, 0.95 * p_max, rows)
-        p[0] = 1e-12 * p_max  # the zero-load state, just above the snap-in plateau
-        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
-    p[0] = 0.0
+    p, a = adhesive_cell_curve(W, seed=seed, rows=rows)
     return p * AREA * E, a * TAU * AREA
 
 
