@@ -13,7 +13,6 @@ drift with w over that range.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import Any
 
@@ -97,16 +96,7 @@ def _profile_edge(
 
 def adhesive_model(model: str | ForwardModel, adhesion: float) -> ForwardModel:
     """The forward model ``model`` (a name or a ForwardModel) with adhesion w / (E* R)."""
-    base = get_model(model)
-    if not dataclasses.is_dataclass(base) or "adhesion" not in {
-        f.name for f in dataclasses.fields(base)
-    }:
-        raise MetainterfaceError(
-            f"model {base.label!r} takes no adhesion; calibrate with 'independent' or "
-            "'interacting'",
-            argument="model",
-        )
-    return dataclasses.replace(base, adhesion=adhesion)
+    return get_model(model).with_adhesion(adhesion)
 
 
 def design_friction(

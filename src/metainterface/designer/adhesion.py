@@ -7,7 +7,6 @@ w / (E* R) in ``meta["friction"]["adhesion"]``, and the design step's model take
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
@@ -76,14 +75,7 @@ def model_for_targets(
                 argument="model",
             )
         return model
-    if not dataclasses.is_dataclass(model) or "adhesion" not in {
-        f.name for f in dataclasses.fields(model)
-    }:
-        raise MetainterfaceError(
-            f"model {model.label!r} does not take adhesion; use 'independent' or 'interacting'",
-            argument="model",
-        )
-    return dataclasses.replace(model, adhesion=w)
+    return model.with_adhesion(w)
 
 
 #: The work of adhesion a friction-law design without one is checked at [J/m^2]: typical of
@@ -123,9 +115,9 @@ def adhesion_notes(
             "mJ/m^2)",
         )
     w = work_of_adhesion / (e_star * radius)
-    if not 0 < w <= ADHESION_LIMIT or not dataclasses.is_dataclass(model):
+    if not 0 < w <= ADHESION_LIMIT or not model.takes_adhesion:
         return ()
-    sticky = dataclasses.replace(model, adhesion=w)
+    sticky = model.with_adhesion(w)
     p = np.asarray(result.target.p_star, dtype=np.float64)
     p = p[p > 0]
     if p.size == 0:

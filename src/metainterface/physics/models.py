@@ -18,7 +18,7 @@ instances; ``register_model`` adds one, and it is then accepted by ``design``, `
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, fields, is_dataclass
+from dataclasses import dataclass, fields, is_dataclass, replace
 
 import numpy as np
 import torch
@@ -131,6 +131,21 @@ class ForwardModel(ABC):
         """The sweep where only P* and alpha are needed (S* may be NaN); a model overrides
         it where leaving S* out is cheaper."""
         return self.sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta)
+
+    @property
+    def takes_adhesion(self) -> bool:
+        """Whether the model has an ``adhesion`` option (``with_adhesion`` can set it)."""
+        return is_dataclass(self) and "adhesion" in {f.name for f in fields(self)}
+
+    def with_adhesion(self, adhesion: float) -> ForwardModel:
+        """This model with work of adhesion ``adhesion`` [E* R]; a one-line error for a
+        model that takes none."""
+        if not self.takes_adhesion:
+            raise MetainterfaceError(
+                f"model {self.label!r} does not take adhesion; use 'independent' or 'interacting'",
+                argument="model",
+            )
+        return replace(self, adhesion=adhesion)  # type: ignore[type-var]
 
     @property
     def label(self) -> str:

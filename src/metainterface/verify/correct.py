@@ -33,7 +33,6 @@ model: no extra BEM solve.
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -201,11 +200,7 @@ def with_adhesion(inner: ForwardModel, model: ForwardModel) -> ForwardModel:
     takes no adhesion."""
     if not model.adhesion or inner.adhesion == model.adhesion:
         return inner
-    if dataclasses.is_dataclass(inner) and "adhesion" in {
-        f.name for f in dataclasses.fields(inner)
-    }:
-        return dataclasses.replace(inner, adhesion=model.adhesion)
-    return model
+    return inner.with_adhesion(model.adhesion) if inner.takes_adhesion else model
 
 
 def correct(
