@@ -11,16 +11,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from metainterface.errors import MetainterfaceError
+from metainterface.inverse.envelope import target_adhesion
 from metainterface.physics.models import ForwardModel
-
-
-def target_adhesion(target: Any) -> float:
-    """w / (E* R) that a target was converted with (0: none or not a friction law)."""
-    meta = getattr(target, "meta", None) or {}
-    friction = meta.get("friction") if isinstance(meta, dict) else None
-    if not isinstance(friction, dict):
-        return 0.0
-    return float(friction.get("adhesion", 0.0) or 0.0)
 
 
 def given_adhesion(
