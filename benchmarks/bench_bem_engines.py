@@ -75,6 +75,14 @@ def main() -> None:
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--profile", action="store_true", help="print torch.profiler's table first")
     ap.add_argument("--quick", action="store_true", help="one 96 x 96 path of 3 loads, no file")
+    ap.add_argument(
+        "--engines",
+        nargs="+",
+        choices=["tamaas", "cpu", "gpu"],
+        default=["tamaas", "cpu", "gpu"],
+        help="columns to run (the others read 'unmeasured'); a GPU timing alone, with no other "
+        "engine's work on the machine: --engines gpu",
+    )
     args = ap.parse_args()
     import torch
 
@@ -86,10 +94,12 @@ def main() -> None:
         print(profile(args.grids[0]))
     try:
         require_tamaas()
-        have_tamaas = True
+        have_tamaas = "tamaas" in args.engines
     except Exception:
         have_tamaas = False
-    gpu = torch.cuda.is_available()
+    gpu = torch.cuda.is_available() and "gpu" in args.engines
+    if "cpu" not in args.engines:
+        args.threads = []
     design = Design.load(EXAMPLE)
     loads = get_model().model_curve(design).p_star_max * np.arange(1, args.loads + 1) / args.loads
     cols = ["Tamaas (1 thread)"] + [f"torch CPU, {t} thread{'s' * (t > 1)}" for t in args.threads]

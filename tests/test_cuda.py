@@ -154,3 +154,34 @@ def test_tolerance_and_curve_on_cuda_match_cpu():
     assert r.robust is not None and r.printable is not None
     s = mi.min_radius(d, printer_sigma="1um", max_error=0.05, samples=64, device="cuda")
     assert s.radius_m > 0
+
+
+def test_adhesive_training_loss_on_cuda_matches_cpu():
+    """The adhesive network's loss (each target at its own work of adhesion) is the same on
+    CUDA as on the CPU, gradients included."""
+    from metainterface.physics import CellSettings
+    from metainterface.surrogate.adhesive import adhesive_error
+    from metainterface.surrogate.loss import CurveTargets
+
+    s = CellSettings()
+    gen = torch.Generator().manual_seed(3)
+    g = 1.8 + 2.2 * torch.rand(16, 9, generator=gen, dtype=torch.float64)
+    h = 0.5 * s.delta_max * torch.rand(16, 9, generator=gen, dtype=torch.float64)
+    w = 10 ** (-6 + 2.5 * torch.rand(16, generator=gen, dtype=torch.float64))
+    t = CurveTargets(
+        torch.linspace(0.1, 1, s.n_steps).expand(16, -1),
+        torch.zeros(16, s.n_steps),
+        torch.full((16,), 1e-4),
+        torch.full((16,), 0.05),
+    )
+    out = {}
+    for dev in ("cpu", "cuda"):
+        gd = g.to(dev).requires_grad_()
+        moved = CurveTargets(
+            *(x.to(dev) for x in (t.alpha_hat, t.stiffness_hat, t.p_star_max, t.alpha_max))
+        )
+        err = adhesive_error(gd, h.to(dev), moved, s, w.to(dev))
+        err.sum().backward()
+        out[dev] = (err.detach().cpu(), gd.grad.cpu())
+    assert torch.allclose(out["cpu"][0], out["cuda"][0], rtol=1e-9, atol=1e-12)
+    assert torch.allclose(out["cpu"][1], out["cuda"][1], rtol=1e-6, atol=1e-9)

@@ -49,6 +49,12 @@ _GOLDEN_STEPS = 48
 # --- the cell ---------------------------------------------------------------------------------
 
 
+def per_design(w: Tensor, gamma: Tensor) -> Tensor:
+    """A work of adhesion given as a tensor, as one value per design (B,) of gamma (B, N)."""
+    w = w.to(dtype=gamma.dtype, device=gamma.device).reshape(-1)
+    return w.expand(gamma.shape[0]) if w.numel() == 1 else w
+
+
 @dataclass(frozen=True)
 class AdhesiveState:
     """Each asperity of (B, N) designs at the approaches Delta (B or 1, K), layout (B, N, K).
@@ -68,7 +74,7 @@ def adhesive_state(
     gamma: Tensor,
     h: Tensor,
     settings: CellSettings,
-    w: float,
+    w: float | Tensor,
     delta: Tensor,
     *,
     unloading: bool = False,
@@ -77,7 +83,8 @@ def adhesive_state(
 ) -> AdhesiveState:
     """The JKR state of every asperity at the approaches ``delta`` (K,) or (B, K) [length].
 
-    gamma, h: (B, N), h anchored here (min h -> 0). w: work of adhesion [E* R].
+    gamma, h: (B, N), h anchored here (min h -> 0). w: work of adhesion [E* R], one for all
+    designs or one per design (B,).
     Loading (default): asperity i is in contact where its compression x_i >= 0 (snap-in at
     touch). ``unloading``: from Delta_max down; every asperity that touched by Delta_max
     (h_i <= Delta_max) stays attached while x_i >= delta(a_d). kernel: the (N, N)
@@ -90,7 +97,8 @@ def adhesive_state(
     hh = anchor(h)[:, :, None]
     d = delta[None, None, :] if delta.dim() == 1 else delta[:, None, :]
     gap0 = d - hh  # (B, N, K)
-    w_t = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
+    w_t = per_design(w, gamma)[:, None, None] if isinstance(w, Tensor) else w
+    w_t = torch.as_tensor(w_t, dtype=gamma.dtype, device=gamma.device)
     x_d = jkr_indentation(g, detach_radius(g, w_t, radius), w_t, radius)  # (B, N, 1), <= 0
     reached = hh <= settings.delta_max * (1 + 1e-12)
 
@@ -149,7 +157,7 @@ def sweep_adhesive(
     gamma: Tensor,
     h: Tensor,
     settings: CellSettings,
-    w: float,
+    w: float | Tensor,
     *,
     n_delta: int | None = None,
     delta: Tensor | None = None,
@@ -158,6 +166,7 @@ def sweep_adhesive(
 ) -> tuple[Sweep, Tensor]:
     """The loading curve of (B, N) adhesive designs under a rising normal force.
 
+    w: work of adhesion [E* R], one for all designs or one per design (B,).
     delta: (K,) or (B, K) approaches [length] on [0, Delta_max] (default ``n_delta`` uniform
     ones). Returns the Sweep (delta; P* (B, K) the running maximum of the cell's force,
     floored at 0; alpha (B, K) the state the cell is in at that force: where the force is

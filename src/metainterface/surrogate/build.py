@@ -79,7 +79,9 @@ def train_surrogate(
     ``out/model.pt``, usable as ``design(..., effort=Effort(surrogate=out / "model.pt"))``. With
     ``config.reads == "laws"`` it trains on targets made from the dataset's cells the way
     friction laws arrive (``metainterface.surrogate.laws``), usually from ``config.init``,
-    the shipped network (``TrainConfig.laws()``). ``device``
+    the shipped network (``TrainConfig.laws()``); with ``"adhesive"`` on the adhesive loading
+    curves of its cells (``metainterface.surrogate.adhesive``, ``TrainConfig.adhesive()``).
+    ``device``
     ("auto", "cpu", "cuda", "cuda:N") is where the model and the dataset live while it
     trains; the files load on any device (a run may be resumed on another one)."""
     dev = resolve_device(device)
@@ -93,6 +95,21 @@ def train_surrogate(
             # the validation targets get their own seed: other cuts of other cells
             train_split = law_split(train_split, ds.settings, config.seed, progress=progress)
             val_split = law_split(val_split, ds.settings, config.seed + 1, progress=progress)
+    elif config.reads == "adhesive":
+        from metainterface.surrogate.adhesive import adhesive_split
+
+        with torch.inference_mode():
+            train_split, val_split = (
+                adhesive_split(
+                    part,
+                    ds.settings,
+                    config.seed + k,
+                    adhesion_input=config.adhesion_input,
+                    progress=progress,
+                    device=dev,
+                )
+                for k, part in enumerate((train_split, val_split))
+            )
     return train(
         train_split,
         val_split,
@@ -132,4 +149,13 @@ def evaluate_surrogate(
         with torch.inference_mode():
             train_split = law_split(train_split, settings, LAW_SEEDS[0], progress=progress)
             test_split = law_split(test_split, settings, LAW_SEEDS[1], progress=progress)
+    elif reads == "adhesive":
+        from metainterface.surrogate.adhesive import adhesive_split
+
+        reads_w = bool(config.get("model", {}).get("adhesion_input", False))
+        with torch.inference_mode():
+            train_split, test_split = (
+                adhesive_split(part, settings, seed, adhesion_input=reads_w, progress=progress)
+                for part, seed in zip((train_split, test_split), LAW_SEEDS, strict=True)
+            )
     return evaluate(model, train_split, test_split, settings, weights_of(config), reads)

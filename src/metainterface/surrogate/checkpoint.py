@@ -74,7 +74,12 @@ def load_model(path: str | os.PathLike[str]) -> tuple[InverseMLP, CellSettings, 
         settings = CellSettings(**config["settings"])
         # files made before the gap scale was a setting used the paper's (max_gap None)
         arch = config.get("model", {"max_gap": None})
-        model = InverseMLP(settings.n_asperities, settings.n_steps, arch["max_gap"])
+        model = InverseMLP(
+            settings.n_asperities,
+            settings.n_steps,
+            arch["max_gap"],
+            adhesion_input=bool(arch.get("adhesion_input", False)),
+        )
         model.load_state_dict(blob["state_dict"])
     except (KeyError, TypeError, RuntimeError, MetainterfaceError) as exc:
         raise MetainterfaceError(f"model {path}: inconsistent weights file ({exc})") from None
@@ -112,3 +117,10 @@ def default_laws_model_path() -> Path:
     way friction laws arrive (``metainterface.surrogate.laws``); `design` also reads targets
     without stiffness with it when it uses the shipped surrogate."""
     return default_model_path().with_name("surrogate_laws.pt")
+
+
+def default_adhesive_model_path() -> Path:
+    """The shipped network for adhesive targets: the friction-law network fine-tuned on
+    adhesive loading curves (``metainterface.surrogate.adhesive``); `design` reads a target
+    with it too when its model has adhesion and it uses the shipped surrogate."""
+    return default_model_path().with_name("surrogate_adhesive.pt")

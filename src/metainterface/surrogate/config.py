@@ -12,7 +12,7 @@ from metainterface.surrogate.model import MAX_GAP
 from metainterface.surrogate.schedules import Schedules
 
 #: What a network can be trained to read (TrainConfig.reads).
-READS = ("curves", "laws")
+READS = ("curves", "laws", "adhesive")
 
 
 #: The settings that make the friction-law network: curve error only (warped and shaped
@@ -31,6 +31,11 @@ LAWS_PRESET = {
     "w_mag": 0.0,
     "w_curve": 100.0,
 }
+
+
+#: The settings that make the adhesive network: the friction-law network's recipe, started
+#: from it, on adhesive targets (``metainterface.surrogate.adhesive``).
+ADHESIVE_PRESET = {**LAWS_PRESET, "reads": "adhesive", "epochs": 40}
 
 
 @dataclass(frozen=True)
@@ -71,7 +76,12 @@ class TrainConfig:
         What the network learns to read: ``"curves"``, the dataset's exact curves with their
         stiffness (the shipped surrogate), or ``"laws"``, targets made from the dataset's
         cells the way friction laws arrive (``metainterface.surrogate.laws``: ended
-        anywhere, a few points, no stiffness, near but not on a cell's curve).
+        anywhere, a few points, no stiffness, near but not on a cell's curve), or
+        ``"adhesive"``, the adhesive loading curves of the dataset's cells at works of
+        adhesion drawn over a range (``metainterface.surrogate.adhesive``).
+    adhesion_input : bool
+        With ``reads="adhesive"``: whether the network is also given log10 w / (E* R) as an
+        input (else it reads the curve alone).
     init : str or None
         A model file to start from (its weights; the input standardisation is refitted to
         this run's inputs with the first layer compensated, so the start predicts as the
@@ -96,11 +106,17 @@ class TrainConfig:
     w_mag: float = 1000.0
     w_curve: float = 300.0
     reads: str = "curves"
+    adhesion_input: bool = False
     init: str | None = None
 
     def __post_init__(self) -> None:
         if self.reads not in READS:
             raise MetainterfaceError(f"reads must be one of {', '.join(READS)}, got {self.reads!r}")
+        if self.adhesion_input and self.reads != "adhesive":
+            raise MetainterfaceError(
+                f"adhesion_input needs reads='adhesive' (the targets' work of adhesion), got "
+                f"reads={self.reads!r}"
+            )
         big = 1_000_000  # epochs, batches, steps: beyond this a run would not end
         for name, low, high in (
             ("epochs", 1, big),
@@ -133,6 +149,14 @@ class TrainConfig:
         from metainterface.surrogate.checkpoint import default_model_path
 
         return cls(**{**LAWS_PRESET, "init": str(default_model_path()), **changes})
+
+    @classmethod
+    def adhesive(cls, **changes: Any) -> TrainConfig:
+        """The settings of the adhesive network (``ADHESIVE_PRESET``, starting from the
+        shipped friction-law network), with ``changes``."""
+        from metainterface.surrogate.checkpoint import default_laws_model_path
+
+        return cls(**{**ADHESIVE_PRESET, "init": str(default_laws_model_path()), **changes})
 
     @property
     def weights(self) -> LossWeights:

@@ -23,6 +23,8 @@ class Split:
     gamma: Tensor  # (S, N)
     h: Tensor  # (S, N)
     category: np.ndarray  # (S,) str
+    #: (S,) float64 work of adhesion w / (E* R) of each target (adhesive targets, else None)
+    adhesion: Tensor | None = None
 
     def __len__(self) -> int:
         return self.features.shape[0]
@@ -43,7 +45,12 @@ class Split:
             self.gamma.to(device),
             self.h.to(device),
             self.category,
+            None if self.adhesion is None else self.adhesion.to(device),
         )
+
+    def adhesion_rows(self, idx: Tensor) -> Tensor | None:
+        """The work of adhesion of the rows ``idx`` (None for targets without adhesion)."""
+        return None if self.adhesion is None else self.adhesion.index_select(0, idx)
 
     def rows(self, idx: Tensor) -> tuple[Tensor, CurveTargets, Tensor, Tensor]:
         """The rows ``idx`` (a 1-D index tensor): features, targets, gamma, h."""

@@ -5,11 +5,13 @@ pressure grid of each test curve, alpha_pred from the exact forward model of the
 design (held at its last value beyond its P*_max). Also the absolute errors of log10 P*_max and
 log10 alpha_max, and the train/test loss gap (exact physics, eval mode).
 
-A friction-law network (trained with ``reads="laws"``) is evaluated on targets made from the
-test split's cells the way it was trained (``metainterface.surrogate.laws``), per kind, with
-alpha solved exactly at each target pressure (cut targets may span a few of the design's own
-grid steps); the log10 errors, which compare a law's end with the design's Delta_max, are
-not reported for them.
+A friction-law network (trained with ``reads="laws"``), or an adhesive one
+(``reads="adhesive"``: errors of the adhesive loading curves at each target's work of
+adhesion), is evaluated on targets made from the test split's cells the way it was trained
+(``metainterface.surrogate.laws``, ``metainterface.surrogate.adhesive``), per kind, with
+alpha solved exactly at each target pressure (cut targets may span a few of the design's
+own grid steps); the log10 errors, which compare a law's end with the design's Delta_max,
+are not reported for them.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import curve
 from metainterface.physics.metrics import relative_l2
 from metainterface.physics.pressures import alpha_at
+from metainterface.surrogate.adhesive import adhesive_error
 from metainterface.surrogate.data import Split
 from metainterface.surrogate.loss import PAPER_WEIGHTS, LossWeights
 from metainterface.surrogate.model import InverseMLP
@@ -55,6 +58,15 @@ def predict_split(
             feats, t, _, _ = split.rows(idx)
             gamma, h = model.design(feats, settings)
             gamma, h = gamma.double(), h.double()
+            if split.adhesion is not None:  # adhesive targets: their loading curves
+                w = split.adhesion_rows(idx)
+                errs.append(adhesive_error(gamma, h, t, settings, w, n_delta=512).numpy())
+                nan = np.full(len(idx), np.nan)
+                lp.append(nan)
+                la.append(nan)
+                gs.append(gamma.numpy())
+                hs.append(h.numpy())
+                continue
             p_grid = (
                 torch.linspace(0, 1, settings.n_steps, dtype=torch.float64)[None]
                 * t.p_star_max.double()[:, None]
@@ -83,8 +95,9 @@ def evaluate(
 ) -> dict:
     """The evaluation table: per category and overall, plus the train/test loss gap (the
     loss with ``weights``: those the model was trained with, see :func:`weights_of`).
-    ``reads="laws"``: the splits hold friction-law-like targets (categories: their kinds)."""
-    laws = reads == "laws"
+    ``reads="laws"``: the splits hold friction-law-like targets (categories: their kinds);
+    ``"adhesive"``: adhesive targets (categories: the decade of their work of adhesion)."""
+    laws = reads in ("laws", "adhesive")
     pred = predict_split(model, test, settings, exact=laws)
     rows = {}
     for name in [*sorted(set(pred.category.tolist())), "all"]:

@@ -1,9 +1,10 @@
 """The inverse MLP of the paper (sec. 3, appendix A.1, table A.1).
 
 Input: the flattened normalised curve (alpha_hat, S_hat) on n_steps pressures plus
-[log10 P*_max, log10 alpha_max] (2 n_steps + 2 values). Output: 2N sigmoids mapped to
-gamma_i = gamma_min + (gamma_max - gamma_min) y_i and to heights through gaps
-g_1 = 0, g_j = y_j G, h = cumsum(g), sorted by construction.
+[log10 P*_max, log10 alpha_max] (2 n_steps + 2 values); a network for adhesive targets may
+also read log10 of the work of adhesion w / (E* R) (``adhesion_input``, one more value).
+Output: 2N sigmoids mapped to gamma_i = gamma_min + (gamma_max - gamma_min) y_i and to
+heights through gaps g_1 = 0, g_j = y_j G, h = cumsum(g), sorted by construction.
 
 The gap scale G is the one deliberate departure from the paper. The paper's G = 2 Delta_max
 / (N - 1) (0.25 Delta_max for N = 9) caps h_k at (k - 1) G, so a cell whose second asperity
@@ -66,6 +67,9 @@ class Dropout(nn.Module):
 class InverseMLP(nn.Module):
     """Curve features (B, 2 n_steps + 2) -> raw outputs y in [0, 1]^(2N).
 
+    With ``adhesion_input`` the features carry one more column, log10(w / (E* R))
+    (:func:`adhesion_column`).
+
     The input is standardised by fixed buffers (set from the training split with
     :meth:`set_input_scaling`; identity by default), then Linear 512 + BatchNorm + GELU +
     Dropout, Linear 256 + BatchNorm + GELU + Dropout, Linear 128 + BatchNorm + GELU,
@@ -73,14 +77,19 @@ class InverseMLP(nn.Module):
     """
 
     def __init__(
-        self, n_asperities: int = 9, n_steps: int = 128, max_gap: float | None = MAX_GAP
+        self,
+        n_asperities: int = 9,
+        n_steps: int = 128,
+        max_gap: float | None = MAX_GAP,
+        adhesion_input: bool = False,
     ) -> None:
         super().__init__()
         check_max_gap(max_gap)
         self.n_asperities = n_asperities
         self.n_steps = n_steps
         self.max_gap = max_gap
-        n_in = 2 * n_steps + 2
+        self.adhesion_input = bool(adhesion_input)
+        n_in = 2 * n_steps + 2 + int(self.adhesion_input)
         layers: list[nn.Module] = []
         width = n_in
         for i, hidden in enumerate(HIDDEN):
@@ -106,17 +115,24 @@ class InverseMLP(nn.Module):
     def forward(self, features: Tensor) -> Tensor:
         return self.net((features - self.in_mean) / self.in_std)
 
-    def architecture(self) -> dict[str, int | float | None]:
+    def architecture(self) -> dict[str, int | float | bool | None]:
         """The constructor arguments, JSON-ready (stored in model files)."""
         return {
             "n_asperities": self.n_asperities,
             "n_steps": self.n_steps,
             "max_gap": self.max_gap,
+            "adhesion_input": self.adhesion_input,
         }
 
     def design(self, features: Tensor, settings: CellSettings) -> tuple[Tensor, Tensor]:
         """Curve features (B, 2 n_steps + 2) -> predicted (gamma, h), each (B, N)."""
         return outputs_to_design(self(features), settings, self.max_gap)
+
+
+def adhesion_column(w: Tensor) -> Tensor:
+    """The input column of a network that reads adhesion: log10 of w / (E* R), (B,) -> (B, 1),
+    floored at 1e-12 (no adhesion reads as very little)."""
+    return torch.log10(w.clamp_min(1e-12))[:, None]
 
 
 def outputs_to_design(

@@ -83,7 +83,10 @@ def evaluate_loss(
             idx = torch.arange(lo, min(lo + chunk, len(split)), device=split.features.device)
             feats, targets, _, _ = split.rows(idx)
             gamma, h = model.design(feats, settings)
-            total += float(batch_loss(gamma, h, targets, settings, weights, reads)) * len(idx)
+            loss = batch_loss(
+                gamma, h, targets, settings, weights, reads, adhesion=split.adhesion_rows(idx)
+            )
+            total += float(loss) * len(idx)
     return total / len(split)
 
 
@@ -96,12 +99,22 @@ def batch_loss(
     reads: str = "curves",
     smooth: float | None = None,
     n_delta: int | None = None,
+    adhesion: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """The training loss of predicted (B, N) designs (a scalar). Curves: the composite loss
     on the design's curve (``smooth``: the softplus steepness kappa_s, None for the exact
     law; ``n_delta`` Delta samples). Laws: ``weights.curve`` times the mean
     :func:`~metainterface.surrogate.loss.law_error`, exact law at the target's pressures
-    (a target that ends early is seen at full resolution)."""
+    (a target that ends early is seen at full resolution). Adhesive: ``weights.curve``
+    times the mean :func:`~metainterface.surrogate.adhesive.adhesive_error` at each
+    target's work of adhesion ``adhesion`` (B,), on an ``n_delta`` sweep."""
+    if reads == "adhesive":
+        from metainterface.surrogate.adhesive import adhesive_error
+
+        if adhesion is None:
+            raise MetainterfaceError("adhesive targets need their work of adhesion")
+        err = adhesive_error(gamma, h, targets, settings, adhesion, n_delta=n_delta or 64)
+        return weights.curve * err.mean()
     if reads == "laws":
         return weights.curve * law_error(gamma, h, targets, settings).mean()
     pred = curve(gamma, h, settings, smooth=smooth, n_delta=n_delta)
@@ -144,7 +157,12 @@ def train(
     out = Path(out_dir)
     ckpt_path = out / "checkpoint.pt"
     torch.manual_seed(config.seed)
-    model = InverseMLP(settings.n_asperities, settings.n_steps, config.max_gap).to(dev)
+    model = InverseMLP(
+        settings.n_asperities,
+        settings.n_steps,
+        config.max_gap,
+        adhesion_input=config.adhesion_input,
+    ).to(dev)
     if config.init is not None and not resume:
         _start_from(model, config.init, settings, train_split.features)
     else:
@@ -228,6 +246,7 @@ def train(
                 config.reads,
                 kappa,
                 config.physics_steps,
+                adhesion=train_split.adhesion_rows(order[lo : lo + config.batch_size]),
             )
             if lam > 0:
                 loss = loss + lam * param_loss(gamma, h, g_t, h_t, settings)
@@ -306,7 +325,8 @@ def _start_from(model: InverseMLP, path: str, settings: CellSettings, features) 
     """Load a model file's weights into ``model`` and refit the input standardisation to
     ``features``, folding the change into the first layer so the network computes what the
     file's did. Inputs that were constant where the file was trained
-    (``InverseMLP.constant_inputs``) carried nothing; their weights start at 0."""
+    (``InverseMLP.constant_inputs``) carried nothing; their weights start at 0, as do those
+    of an input the file's network did not have (the adhesion column)."""
     src, trained, _ = load_model(path)
     if trained != settings:
         raise MetainterfaceError(
@@ -317,8 +337,20 @@ def _start_from(model: InverseMLP, path: str, settings: CellSettings, features) 
         raise MetainterfaceError(
             f"init model {path}: max_gap {src.max_gap} differs from this run's {model.max_gap}"
         )
+    state = src.state_dict()
+    extra = model.in_mean.numel() - src.in_mean.numel()
+    if extra < 0 or (extra > 0 and not model.adhesion_input):
+        raise MetainterfaceError(
+            f"init model {path}: reads {src.in_mean.numel()} inputs, this run's network "
+            f"{model.in_mean.numel()}"
+        )
+    if extra:  # the new input column starts with no weight, standardised as a no-op
+        first = state["net.0.weight"]
+        state["net.0.weight"] = torch.cat([first, first.new_zeros(first.shape[0], extra)], 1)
+        state["in_mean"] = torch.cat([state["in_mean"], state["in_mean"].new_zeros(extra)])
+        state["in_std"] = torch.cat([state["in_std"], state["in_std"].new_ones(extra)])
     with torch.no_grad():
-        model.load_state_dict(src.state_dict())
+        model.load_state_dict(state)
         old_mean, old_std = model.in_mean.clone(), model.in_std.clone()
         live = ~model.constant_inputs()
         model.set_input_scaling(features)
