@@ -215,6 +215,35 @@ def sweep_adhesive(
     ), per_j
 
 
+def touch_loads(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    w: float,
+    *,
+    kernel: Tensor | None = None,
+    iterations: int = ITERATIONS,
+) -> Tensor:
+    """(B, N) the largest P* the cell carries, loaded by approach, before each asperity
+    touches.
+
+    Under a rising force an asperity snaps in at its touch and the cell jumps on to where the
+    force regains the load it had just before (its running maximum): every state of the
+    load-controlled curve with asperity i in contact carries at least the i-th of these
+    loads (0 for the first to touch). A state met by approach with i in contact below it
+    lies on a branch a rising force jumps over. Between touches the force rises, so its
+    running maximum up to a touch is the largest of the loads just before each earlier
+    touch. Touch at Delta = h_i (the interaction's shift of it is left out).
+    """
+    hh = anchor(h)
+    delta = hh * (1.0 - 1e-9)  # (B, N) approaches just short of each touch
+    st = adhesive_state(gamma, h, settings, w, delta, kernel=kernel, iterations=iterations)
+    before = torch.clamp_min(st.force.sum(1) / settings.nominal_area, 0.0)  # (B, N)
+    order = torch.argsort(hh, dim=-1)
+    peak = torch.cummax(before.gather(-1, order), dim=-1).values
+    return torch.empty_like(peak).scatter_(-1, order, peak)
+
+
 def _unloading_grid(
     gamma: Tensor, h: Tensor, settings: CellSettings, w: float, n_delta: int
 ) -> Tensor:

@@ -350,7 +350,9 @@ class AdhesivePath:
     of the surface's own tips-down plane); p_star, alpha: (K,) the BEM's mean pressure and
     contact fraction there; loading: (K,) bool, the samples of the rising part; on_branch:
     (K,) bool, the loading samples a rising force reaches (force at its running maximum
-    and > 0: the states of the load-controlled curve the forward model gives).
+    and > 0: the states of the load-controlled curve the forward model gives, as far as the
+    samples tell: a peak between two samples is not seen); touching: (K, N) bool, which
+    asperities have a point in contact (with ``owner``, else None).
     """
 
     approach: np.ndarray
@@ -358,6 +360,7 @@ class AdhesivePath:
     alpha: np.ndarray
     loading: np.ndarray
     on_branch: np.ndarray
+    touching: np.ndarray | None = None
 
 
 def jkr_path(
@@ -368,23 +371,38 @@ def jkr_path(
     *,
     unload: np.ndarray | None = None,
     device: torch.device | str = "cpu",
+    owner: np.ndarray | None = None,
 ) -> AdhesivePath:
     """One cell (M, M) along rising ``approaches`` (K,) [length], then falling ``unload``
-    ones, each state warm-started from the one before (the contact's history matters)."""
+    ones, each state warm-started from the one before (the contact's history matters).
+    ``owner``: (M, M) the asperity index of each point (``heightmap.owner_map``), for the
+    path's ``touching``."""
     z = torch.as_tensor(np.ascontiguousarray(heights, dtype=np.float64), device=device)[None]
     z_bar = -float(z.mean())
     up = np.asarray(approaches, dtype=np.float64)
     down = np.zeros(0) if unload is None else np.asarray(unload, dtype=np.float64)
     contact = pressure = None
-    p_star, alpha = [], []
+    p_star, alpha, touching = [], [], []
+    n_owner = 0 if owner is None else int(owner.max()) + 1
+    own = None if owner is None else torch.as_tensor(owner, device=z.device).reshape(-1)
     for d in np.concatenate([up, down]):
         target = torch.tensor([z_bar - d], dtype=torch.float64, device=z.device)
         sol = solve_jkr(z, side, target, work, contact=contact, pressure=pressure)
         contact, pressure = sol.contact, sol.pressure
         p_star.append(float(sol.p_star[0]))
         alpha.append(float(sol.alpha[0]))
+        if own is not None:
+            hits = torch.bincount(own[sol.contact[0].reshape(-1)], minlength=n_owner)
+            touching.append((hits > 0).cpu().numpy())
     p = np.array(p_star)
     loading = np.arange(p.size) < up.size
     top = np.maximum.accumulate(np.where(loading, p, -np.inf))
     on_branch = loading & (p >= top) & (p > 0)
-    return AdhesivePath(np.concatenate([up, down]), p, np.array(alpha), loading, on_branch)
+    return AdhesivePath(
+        np.concatenate([up, down]),
+        p,
+        np.array(alpha),
+        loading,
+        on_branch,
+        np.array(touching) if own is not None else None,
+    )

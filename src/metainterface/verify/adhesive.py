@@ -8,9 +8,10 @@ the adhesive torch BEM in the JKR limit (``validation.adhesive_bem``, Pohrt-Popo
 criterion) by approach, at K approaches from touch up to a step past where the model
 reaches the check's top load (displacement control: an adhesive contact has unstable
 branches that load control would jump). The states a rising force reaches, those whose
-force is at its running maximum and positive, are the BEM's load-controlled curve; they are
-the check's loads, and the BEM, the model and the target (interpolated) are compared there
-with the adhesionless check's measure,
+force is at its running maximum and positive, and, with each asperity in contact, at least
+the load the cell carried just before that asperity touched (a peak the samples may miss),
+are the BEM's load-controlled curve; they are the check's loads, and the BEM, the model
+and the target (interpolated) are compared there with the adhesionless check's measure,
 
     bem_error = ||alpha_bem - alpha_target||_2 / ||alpha_target||_2,
 
@@ -35,6 +36,11 @@ from metainterface.physics.models import ForwardModel
 #: are not on the rising-force branch (just after a snap-in the force dips below its running
 #: maximum), so the path takes more samples than the loads it is asked for.
 APPROACHES_PER_LOAD = 2
+#: A BEM state with an asperity in contact is on the rising-force branch only at or above
+#: this factor times the load the model's cell carries just before that asperity touches
+#: (``ForwardModel.touch_loads``): the margin covers the BEM's own touch load lying a few
+#: per cent from the model's (states within it sit at a snap-in, where alpha jumps).
+TOUCH_MARGIN = 1.05
 
 
 def approaches(design: Design, model: ForwardModel, top: float, k: int) -> np.ndarray:
@@ -49,6 +55,25 @@ def approaches(design: Design, model: ForwardModel, top: float, k: int) -> np.nd
     end = float(delta[reach[0]]) if reach.size else s.delta_max
     end = min(s.delta_max, end * (1 + 1.0 / k))
     return end * np.arange(1, k + 1) / k
+
+
+def clear_of_snap_ins(p_star: np.ndarray, touching: np.ndarray, peaks: np.ndarray) -> np.ndarray:
+    """(K,) bool: the BEM states (P* (K,), asperities in contact (K, N)) that a rising force
+    reaches and that lie clear of the model's snap-ins (``peaks`` (N,), the model's
+    ``touch_loads``), the states the check compares.
+
+    A state with asperity i in contact below the load the cell had just before i touched
+    was met by approach only: a rising force jumps over it (the sampled running maximum
+    misses that peak when no approach falls just before the touch). A state within a factor
+    TOUCH_MARGIN of a snap-in reads either side of the jump. Both are left out; a state
+    without i in contact well above i's snap-in load is kept: there the BEM touches later
+    than the model, a disagreement the check must see.
+    """
+    p = p_star[:, None]
+    snaps = peaks[None, :] > 0
+    skipped = touching & (p < TOUCH_MARGIN * peaks[None, :])
+    at_jump = ~touching & (p > peaks[None, :] / TOUCH_MARGIN) & (p < TOUCH_MARGIN * peaks[None, :])
+    return ~((skipped | at_jump) & snaps).any(1)
 
 
 @dataclass(frozen=True)
@@ -91,9 +116,13 @@ def solve_adhesive(
     hm = height_map(design, grid)
     t0 = time.perf_counter()
     work = model.adhesion * s.e_star * s.radius  # w [E* length] in the cell's units
-    path = jkr_path(hm.heights, hm.cell_side, work, deltas, device=dev)
+    path = jkr_path(hm.heights, hm.cell_side, work, deltas, device=dev, owner=hm.owner)
     seconds = time.perf_counter() - t0
-    keep = path.on_branch & (path.p_star <= target.p_star_max * (1 + 1e-9))
+    keep = (
+        path.on_branch
+        & clear_of_snap_ins(path.p_star, path.touching, model.touch_loads(design))
+        & (path.p_star <= target.p_star_max * (1 + 1e-9))
+    )
     if not keep.any():
         raise MetainterfaceError(
             "the adhesive BEM reached no load inside the target's range on its rising branch "
