@@ -4,10 +4,10 @@ alone against it with the model's snap-in loads (``verify.adhesive.clear_of_snap
 Random 9-asperity cells (heights in [0, 0.3] Delta_max, so snap-ins crowd the low loads),
 w = 50 mJ/m^2 on PDMS at R = 0.5 mm, the JKR-limit BEM by 2 K approaches as the check
 loads it; per cell the states kept and the largest |alpha_bem / alpha_model - 1| and the
-relative L2 over them (Independent(adhesion) model, load control).
+relative L2 over them (the adhesive model, load control).
 
     PYTHONPATH=src python benchmarks/bench_adhesive_states.py [--grid 96] [--loads 12]
-        [--seeds 0 16]
+        [--seeds 0 16] [--model independent|interacting]
 """
 
 from __future__ import annotations
@@ -31,9 +31,10 @@ def main() -> None:
     ap.add_argument("--grid", type=int, default=96)
     ap.add_argument("--loads", type=int, default=12)
     ap.add_argument("--seeds", type=int, nargs=2, default=[0, 16])
+    ap.add_argument("--model", choices=["independent", "interacting"], default="independent")
     args = ap.parse_args()
     s = CellSettings()
-    model = mi.Independent(adhesion=W)
+    model = (mi.Independent if args.model == "independent" else mi.Interacting)(adhesion=W)
     worst = {"sampled maximum": [], "with snap-in loads": []}
     for seed in range(*args.seeds):
         rng = np.random.default_rng(seed)

@@ -6,7 +6,7 @@ networks' and the floor of the true cells (the targets' own resolution).
 
     python benchmarks/bench_adhesive_surrogate.py --out RUNS [--dataset ds100k.npz]
         [--samples 100000] [--device cuda] [--budget 240] [--batch-size 1024] [--lr 7e-4]
-        [--evaluate-only] [--eval-cells 2000]
+        [--variants input curve] [--max-epochs 60] [--evaluate-only] [--eval-cells 2000]
 
 Training: each variant in its own process, both at once (on a GPU they share it: the steps
 are launch-bound); one probe epoch sets how many epochs fit ``--budget`` seconds (at most
@@ -28,7 +28,7 @@ import torch
 
 import metainterface as mi
 from metainterface.data import load_dataset
-from metainterface.surrogate.adhesive import adhesive_error, adhesive_split
+from metainterface.surrogate.adhesive import AdhesiveTargets, adhesive_error, adhesive_split
 from metainterface.surrogate.build import train_surrogate
 from metainterface.surrogate.checkpoint import (
     default_laws_model_path,
@@ -98,7 +98,7 @@ def evaluate(args) -> None:
         test.h[keep],
         test.category[keep.numpy()],
     )
-    split = adhesive_split(test, s, EVAL_SEED, adhesion_input=True)
+    split = adhesive_split(test, s, EVAL_SEED, adhesion_input=True, spec=AdhesiveTargets(copies=1))
     idx = torch.arange(len(split))
     feats, targets, g, h = split.rows(idx)
     cats = split.category
@@ -164,6 +164,7 @@ def main() -> None:
     ap.add_argument("--lr", type=float, default=7e-4)
     ap.add_argument("--eval-cells", type=int, default=2000)
     ap.add_argument("--evaluate-only", action="store_true")
+    ap.add_argument("--variants", nargs="+", choices=list(VARIANTS), default=list(VARIANTS))
     ap.add_argument("--train", choices=list(VARIANTS), help=argparse.SUPPRESS)
     args = ap.parse_args()
     out = Path(args.out)
@@ -183,7 +184,7 @@ def main() -> None:
                 f"dataset: {args.samples} samples in {time.perf_counter() - t0:.1f} s", flush=True
             )
         base = [sys.executable, __file__, *sys.argv[1:], "--dataset", args.dataset]
-        procs = [subprocess.Popen([*base, "--train", name]) for name in VARIANTS]
+        procs = [subprocess.Popen([*base, "--train", name]) for name in args.variants]
         for p in procs:
             p.wait()
     evaluate(args)

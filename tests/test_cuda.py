@@ -176,7 +176,7 @@ def test_adhesive_training_loss_on_cuda_matches_cpu():
     )
     out = {}
     for dev in ("cpu", "cuda"):
-        gd = g.to(dev).requires_grad_()
+        gd = g.detach().to(dev).requires_grad_()
         moved = CurveTargets(
             *(x.to(dev) for x in (t.alpha_hat, t.stiffness_hat, t.p_star_max, t.alpha_max))
         )

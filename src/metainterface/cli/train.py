@@ -123,10 +123,25 @@ def register(sub: argparse._SubParsersAction) -> None:
         "with it too when it is the shipped weights/surrogate_laws.pt",
     )
     p.add_argument(
+        "--adhesive",
+        action="store_true",
+        help="train the adhesive network: on the adhesive loading curves of the dataset's "
+        "cells at works of adhesion drawn over 1e-6..3e-4 E* R, read as friction laws "
+        "arrive, starting from --init (default: the shipped friction-law network), with "
+        "--laws's settings otherwise; `design` reads targets of a model with adhesion with "
+        "it too when it is the shipped weights/surrogate_adhesive.pt",
+    )
+    p.add_argument(
+        "--adhesion-input",
+        action=argparse.BooleanOptionalAction,
+        help="with --adhesive: give the network log10 of w / (E* R) as an input too (the "
+        "default, as the shipped one), or not (--no-adhesion-input: it reads the curve alone)",
+    )
+    p.add_argument(
         "--init",
         metavar="MODEL",
-        help="start from this model file's weights (with --laws: the shipped surrogate "
-        "unless given)",
+        help="start from this model file's weights (with --laws: the shipped surrogate, "
+        "with --adhesive the shipped friction-law network, unless given)",
     )
     p.add_argument("--resume", action="store_true", help="continue the run in --out")
     add_device(p)
@@ -160,8 +175,17 @@ def run(args: argparse.Namespace) -> int:
     given.update(seed=args.seed, patience=args.patience, max_gap=args.max_gap)
     if args.init is not None:
         given["init"] = args.init
-    make = mi.TrainConfig.laws if args.laws else mi.TrainConfig
-    config = make(**{**({} if args.laws else DEFAULTS), **given})
+    if args.laws and args.adhesive:
+        raise MetainterfaceError("give --laws or --adhesive, not both", argument="--adhesive")
+    if args.adhesion_input is not None and not args.adhesive:
+        raise MetainterfaceError("--adhesion-input needs --adhesive", argument="--adhesion-input")
+    if args.adhesive:
+        if args.adhesion_input is not None:
+            given["adhesion_input"] = args.adhesion_input
+        config = mi.TrainConfig.adhesive(**given)
+    else:
+        make = mi.TrainConfig.laws if args.laws else mi.TrainConfig
+        config = make(**{**({} if args.laws else DEFAULTS), **given})
     result = mi.train_surrogate(
         args.dataset, args.out, config, resume=args.resume, device=args.device
     )

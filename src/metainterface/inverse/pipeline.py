@@ -42,6 +42,7 @@ from metainterface.inverse.starts import (
     hedge_starts,
     predict,
     random_starts,
+    shipped_adhesive_net,
     shipped_laws_net,
 )
 from metainterface.inverse.targets import Target
@@ -357,13 +358,16 @@ def _zero_shot(
     points: int,
 ) -> tuple[Tensor, Tensor, list[str]]:
     """The surrogate's zero-shot designs gamma0, h0 (T, N) of the targets, each the best of
-    its views (:func:`best_views`, on ``points`` pressures), and where each comes from."""
+    its views and the shipped networks' readings (the friction-law network's, the adhesive
+    network's for a model with adhesion; :func:`best_views`, on ``points`` pressures), and
+    where each comes from."""
     from metainterface.surrogate.checkpoint import default_model_path, design_model
 
     net, settings, _ = design_model(model_path or default_model_path())
-    gamma0, h0 = predict(net, targets, settings)
+    gamma0, h0 = predict(net, targets, settings, adhesion=model.adhesion)
     laws_net = shipped_laws_net(model_path, settings, targets)
-    return best_views(net, targets, gamma0, h0, settings, model, points, laws_net)
+    adhesive_net = shipped_adhesive_net(model_path, settings, model)
+    return best_views(net, targets, gamma0, h0, settings, model, points, laws_net, adhesive_net)
 
 
 def _usable_method(

@@ -32,6 +32,7 @@ if TYPE_CHECKING:  # the surrogate (and its imports) load only when a design nee
 
 #: How a zero-shot design's source is named (DesignResult.zero_shot_from).
 SURROGATE, LAWS_NETWORK = "surrogate", "friction-law network"
+ADHESIVE_NETWORK = "adhesive network"
 
 
 def random_starts(
@@ -74,18 +75,27 @@ def hedge_starts(
 
 
 def predict(
-    model: InverseMLP, targets: Sequence[Target], settings: CellSettings
+    model: InverseMLP,
+    targets: Sequence[Target],
+    settings: CellSettings,
+    adhesion: float = 0.0,
 ) -> tuple[Tensor, Tensor]:
-    """Zero-shot designs (T, N) for the targets from the surrogate.
+    """Zero-shot designs (T, N) for the targets from the surrogate (a network that reads
+    adhesion is given ``adhesion``, w / (E* R)).
 
     One target at a time, in float64. Matrix products round differently with the batch size
     (by ~1e-16 in float64), and the refinement's stopping decisions can carry even that into
     another local optimum. Row by row, a target gets the same design alone or in any batch,
     and the network is cheap next to the refinement."""
     net = copy.deepcopy(model).to(DTYPE).eval()
+    extra = None
+    if net.adhesion_input:
+        from metainterface.surrogate.model import adhesion_column
+
+        extra = adhesion_column(torch.tensor([adhesion], dtype=DTYPE))[0]
     with torch.no_grad():
         rows = [
-            net.design(conform(net, target_features(t, settings.n_steps)), settings)
+            net.design(conform(net, target_features(t, settings.n_steps), extra), settings)
             for t in targets
         ]
     return torch.cat([g for g, _ in rows]), torch.cat([h for _, h in rows])
@@ -143,30 +153,38 @@ def best_views(
     model: ForwardModel,
     points: int,
     laws_net: InverseMLP | None = None,
+    adhesive_net: InverseMLP | None = None,
 ) -> tuple[Tensor, Tensor, list[str]]:
     """The zero-shot designs (T, N), each target without stiffness given the best, by the
     error on the target itself, of its own prediction (gamma0, h0), those of its views
     (:func:`target_views`), and, with ``laws_net`` (the network trained on targets made the
-    way friction laws arrive), that network's on the target and its views. Also, per
-    target, which prediction it is (e.g. ``"friction-law network, end x0.4"``)."""
+    way friction laws arrive), that network's on the target and its views; with
+    ``adhesive_net`` (for a model with adhesion), that network's on the target, read without
+    its stiffness, and its views. Also, per target, which prediction it is (e.g.
+    ``"friction-law network, end x0.4"``)."""
     gamma0, h0 = gamma0.clone(), h0.clone()
     labels = [SURROGATE] * len(targets)
     for i, t in enumerate(targets):
-        if t.stiffness is not None:
+        if t.stiffness is not None and adhesive_net is None:
             continue
-        views = target_views(t)
-        ends = [f", end x{v.p_star_max / t.p_star_max:.2g}" for v in views]
         g_c, h_c, names = [gamma0[i : i + 1]], [h0[i : i + 1]], [SURROGATE]
-        if views:
-            g_v, h_v = predict(net, views, settings)
+        plain = t if t.stiffness is None else Target(t.p_star, t.alpha, name=t.name)
+        views = target_views(plain)
+        ends = [f", end x{v.p_star_max / t.p_star_max:.2g}" for v in views]
+        sources = []
+        if t.stiffness is None:
+            sources = [
+                (net, SURROGATE, views, ends),
+                (laws_net, LAWS_NETWORK, [t, *views], ["", *ends]),
+            ]
+        sources.append((adhesive_net, ADHESIVE_NETWORK, [plain, *views], ["", *ends]))
+        for source, label, read, named in sources:
+            if source is None or not read:
+                continue
+            g_v, h_v = predict(source, read, settings, adhesion=model.adhesion)
             g_c.append(g_v)
             h_c.append(h_v)
-            names += [SURROGATE + e for e in ends]
-        if laws_net is not None:
-            g_l, h_l = predict(laws_net, [t, *views], settings)
-            g_c.append(g_l)
-            h_c.append(h_l)
-            names += [LAWS_NETWORK + e for e in ["", *ends]]
+            names += [label + e for e in named]
         if len(g_c) == 1:
             continue
         g, h = torch.cat(g_c), torch.cat(h_c)
@@ -177,6 +195,25 @@ def best_views(
         k = int(err.argmin())
         gamma0[i], h0[i], labels[i] = g[k], h[k], names[k]
     return gamma0, h0, labels
+
+
+def shipped_adhesive_net(
+    model_path: str | os.PathLike[str] | None, settings: CellSettings, model: ForwardModel
+) -> InverseMLP | None:
+    """The shipped adhesive network (``surrogate.adhesive``) where the model has adhesion,
+    the shipped surrogate designs and the network is there for the same cell; else None."""
+    from metainterface.surrogate.checkpoint import (
+        default_adhesive_model_path,
+        default_model_path,
+        design_model,
+    )
+
+    shipped = model_path is None or Path(model_path).resolve() == default_model_path().resolve()
+    path = default_adhesive_model_path()
+    if not model.adhesion or not shipped or not path.is_file():
+        return None
+    net, trained, _ = design_model(path)
+    return net if trained == settings else None
 
 
 def shipped_laws_net(
@@ -199,10 +236,14 @@ def shipped_laws_net(
     return net if trained == settings else None
 
 
-def conform(net: InverseMLP, features: Tensor) -> Tensor:
-    """Features (F,) as a (1, F) float64 batch, with the inputs that were constant in the
-    network's training set set to that constant. The standardisation divides them by a
-    spread of ~1e-6: a target that differs there by round-off or an estimate (S* at P* = 0
-    by finite differences) would push the first layer 1e5 standard deviations away."""
-    x = features.to(DTYPE)[None]
+def conform(net: InverseMLP, features: Tensor, extra: Tensor | None = None) -> Tensor:
+    """Features (F,) as a (1, F) float64 batch (``extra`` columns appended: the adhesion
+    input), with the inputs that were constant in the network's training set set to that
+    constant. The standardisation divides them by a spread of ~1e-6: a target that differs
+    there by round-off or an estimate (S* at P* = 0 by finite differences) would push the
+    first layer 1e5 standard deviations away."""
+    x = features.to(DTYPE)
+    if extra is not None:
+        x = torch.cat([x, extra.to(DTYPE)])
+    x = x[None]
     return torch.where(net.constant_inputs(), net.in_mean.to(DTYPE), x)

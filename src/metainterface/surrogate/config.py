@@ -33,9 +33,17 @@ LAWS_PRESET = {
 }
 
 
-#: The settings that make the adhesive network: the friction-law network's recipe, started
-#: from it, on adhesive targets (``metainterface.surrogate.adhesive``).
-ADHESIVE_PRESET = {**LAWS_PRESET, "reads": "adhesive", "epochs": 40}
+#: The settings that made the shipped adhesive network: the friction-law network's recipe,
+#: started from it, on adhesive targets (``metainterface.surrogate.adhesive``), with the
+#: batch and rate it was trained with on a GPU (weights/MODEL_CARD.md).
+ADHESIVE_PRESET = {
+    **LAWS_PRESET,
+    "reads": "adhesive",
+    "epochs": 60,
+    "batch_size": 1024,
+    "lr": 7e-4,
+    "adhesion_input": True,
+}
 
 
 @dataclass(frozen=True)
