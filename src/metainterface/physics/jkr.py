@@ -124,16 +124,17 @@ def jkr_radius(
     """
     w_t = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
 
-    def residual(a: Tensor, g: Tensor, xx: Tensor, ww: Tensor) -> tuple[Tensor, Tensor]:
-        kc = power_coefficient(g, radius)
-        s = flat_punch_coefficient(ww, radius)
+    def residual(
+        a: Tensor, g: Tensor, xx: Tensor, kc: Tensor, s: Tensor | float
+    ) -> tuple[Tensor, Tensor]:
         root_a = torch.sqrt(a)
         pa = kc * a**g
-        res = pa - s * root_a - xx
-        slope = g * pa / a - 0.5 * s / root_a
+        s_root = s * root_a
+        res = pa - s_root - xx
+        slope = (g * pa - 0.5 * s_root) / a
         if self_coupling is not None:
-            f = 2.0 * g / (g + 1.0) * pa * a - 2.0 * s * a * root_a
-            df = 2.0 * g * pa - 3.0 * s * root_a
+            f = (2.0 * g / (g + 1.0) * pa - 2.0 * s_root) * a
+            df = 2.0 * g * pa - 3.0 * s_root
             res = res + self_coupling * f
             slope = slope + self_coupling * df
         return res, slope
@@ -142,6 +143,7 @@ def jkr_radius(
         g0, x0, w0 = gamma.detach(), x.detach(), w_t.detach()
         a_t = touch_radius(g0, w0, radius)
         a_d = a_t * (2.0 * g0) ** (-1.0 / (g0 - 0.5))
+        # the coefficients once, not at every Newton step (lgamma is most of a step's cost)
         kc = power_coefficient(g0, radius)
         s = flat_punch_coefficient(w0, radius)
         xp = torch.clamp_min(x0, 0.0)
@@ -157,7 +159,7 @@ def jkr_radius(
         floor = torch.broadcast_to(a_d, a.shape)
         tiny = 4.0 * torch.finfo(a.dtype).eps
         for _ in range(NEWTON_STEPS):
-            res, slope = residual(a, g0, x0, w0)
+            res, slope = residual(a, g0, x0, kc, s)
             ok = slope > 0
             step = torch.where(ok, res / torch.where(ok, slope, 1.0), 0.0)
             a_new = torch.maximum(a - step, floor)
@@ -167,6 +169,8 @@ def jkr_radius(
             a = a_new
     if not (gamma.requires_grad or x.requires_grad or w_t.requires_grad):
         return a
-    res, slope = residual(a, gamma, x, w_t)
+    res, slope = residual(
+        a, gamma, x, power_coefficient(gamma, radius), flat_punch_coefficient(w_t, radius)
+    )
     ok = slope.detach() > 0
     return a - torch.where(ok, res / torch.where(ok, slope.detach(), 1.0), 0.0)
