@@ -1,0 +1,66 @@
+"""The issue-38 offset friction law, designed with its work of adhesion and checked in the
+adhesive BEM at two grids: the design's error, and per BEM state alpha_bem / alpha_model - 1.
+
+The law: a held-back adhesive cell's loading curve (``metainterface._testing``, seed 11,
+24 rows) as a friction law in newtons for PDMS on glass (w = 50 mJ/m^2, E* = 2.4 MPa,
+R = 0.5 mm), tau = 0.3 MPa over 4 cm^2. Designed by the default path (``verify=False``),
+then ``bem_check`` with ``Verify(grid=G, loads=12, correct=False)``.
+
+    PYTHONPATH=src python benchmarks/bench_adhesive_offset_check.py [--grids 96 192]
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import metainterface as mi
+from metainterface._testing import adhesive_cell_curve
+from metainterface.verify.check import bem_check
+
+E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--grids", type=int, nargs="+", default=[96, 192])
+    args = ap.parse_args()
+    p, a = adhesive_cell_curve(W_J / (E * R), seed=11, rows=24)
+    path = Path(tempfile.mkdtemp()) / "pdms.csv"
+    rows = zip(p * AREA * E, a * TAU * AREA, strict=True)
+    path.write_text(
+        "normal_force,friction_force\n" + "".join(f"{x:.12g},{y:.12g}\n" for x, y in rows)
+    )
+    scale = dict(shear_strength=TAU, modulus=E, radius=R, area=AREA, fit="never")
+    target = mi.Target.from_friction(path, work_of_adhesion="50mJ/m2", **scale)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        t0 = time.perf_counter()
+        res = mi.design(target, verify=False, effort=mi.Effort(seed=0))
+    print(
+        f"design: error {100 * res.error:.2f} % ({time.perf_counter() - t0:.0f} s), "
+        f"zero-shot from {res.zero_shot_from}",
+        flush=True,
+    )
+    for grid in args.grids:
+        t0 = time.perf_counter()
+        chk = bem_check(
+            res.design, res.target, mi.Verify(grid=grid, loads=12, correct=False), res.model
+        )
+        ratio = chk.alpha_bem / chk.alpha_model - 1
+        l2 = np.linalg.norm(chk.alpha_bem - chk.alpha_model) / np.linalg.norm(chk.alpha_model)
+        print(
+            f"{grid}^2: {chk.p_star.size} states, BEM against the target "
+            f"{100 * chk.bem_error:.2f} %, against the model {100 * l2:.2f} %, per state {np.round(100 * ratio, 1)} % "
+            f"({time.perf_counter() - t0:.0f} s)",
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    main()
