@@ -56,7 +56,8 @@ def main() -> None:
         l2 = np.linalg.norm(chk.alpha_bem - chk.alpha_model) / np.linalg.norm(chk.alpha_model)
         print(
             f"{grid}^2: {chk.p_star.size} states, BEM against the target "
-            f"{100 * chk.bem_error:.2f} %, against the model {100 * l2:.2f} %, per state {np.round(100 * ratio, 1)} % "
+            f"{100 * chk.bem_error:.2f} %, against the model {100 * l2:.2f} %, "
+            f"per state {np.round(100 * ratio, 1)} % "
             f"({time.perf_counter() - t0:.0f} s)",
             flush=True,
         )
