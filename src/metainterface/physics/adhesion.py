@@ -118,6 +118,7 @@ def adhesive_state(
     # the independent state, identical asperities (no relative shift) stay at it exactly.
     x = gap0
     force = torch.zeros_like(gap0)
+    raw: Tensor | None = None
     sweeps = 1 + (iterations if kernel is not None else 0)
     for sweep_no in range(sweeps):
         coupled = off is not None and sweep_no > 0
@@ -127,7 +128,15 @@ def adhesive_state(
         # loading: out of contact is x < 0, where no radius is needed; solving at x = 0
         # instead spares the slow Newton steps near a cusp that nothing reads
         xs = x if unloading else torch.clamp_min(x, 0.0)
-        raw = jkr_radius(g, xs, w_t, radius, self_coupling=self_k if coupled else None)
+        # each sweep's radii start Newton for the next: x moves little between sweeps
+        raw = jkr_radius(
+            g,
+            xs,
+            w_t,
+            radius,
+            self_coupling=self_k if coupled else None,
+            start=raw,
+        )
         # masked with where, not a product: 0^gamma has no gradient in gamma
         force = torch.where(on, jkr_force(g, raw, w_t, radius), 0.0)
         a = torch.where(on, raw, 0.0)

@@ -111,6 +111,7 @@ def jkr_radius(
     radius: float = 1.0,
     *,
     self_coupling: Tensor | None = None,
+    start: Tensor | None = None,
 ) -> Tensor:
     """Contact radius a [length] on the stable branch (a >= a_d) of delta(a) = x [length].
 
@@ -121,6 +122,9 @@ def jkr_radius(
     da/dtheta = -(d residual/dtheta) / (d residual/da), exact at the root.
     self_coupling: k (broadcastable), solves delta(a) + k F(a) / E* = x instead (an
     asperity's own images in the periodic lattice), |k| dF/da small against d delta/da.
+    start: radii to start Newton from where they are on the stable branch (a root of a
+    nearby x, e.g. the interaction's previous sweep); from the left of the root the first
+    step lands right of it (convexity), so any start >= a_d converges.
     """
     w_t = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
 
@@ -146,17 +150,23 @@ def jkr_radius(
         # the coefficients once, not at every Newton step (lgamma is most of a step's cost)
         kc = power_coefficient(g0, radius)
         s = flat_punch_coefficient(w0, radius)
-        xp = torch.clamp_min(x0, 0.0)
-        # a >= a_lo = max(Hertz radius, a0) for x >= 0; two fixed-point steps
-        # a <- ((x + s sqrt(a)) / kc)^(1/gamma) from it stay below the root and near it
-        hertz = (xp / kc) ** (1.0 / g0)
-        a = torch.maximum(hertz, a_t)
-        for _ in range(2):
-            a = ((xp + s * torch.sqrt(a)) / kc) ** (1.0 / g0)
-        # for x < 0 the root lies in [a_d, a0): start at a0, right of it
-        a = torch.where(x0 >= 0, a, a_t)
-        a = torch.broadcast_to(a, torch.broadcast_shapes(a.shape, x0.shape, g0.shape)).clone()
-        floor = torch.broadcast_to(a_d, a.shape)
+        shape = torch.broadcast_shapes(a_t.shape, x0.shape, g0.shape)
+        floor = torch.broadcast_to(a_d, shape)
+        if start is not None:
+            # where the start is off the branch (an asperity just in), a0: right of the root
+            # for x < 0, left of it for x >= 0, where one step lands right of it
+            a = torch.where(start.detach() > floor, start.detach(), a_t).expand(shape).clone()
+        else:
+            xp = torch.clamp_min(x0, 0.0)
+            # a >= a_lo = max(Hertz radius, a0) for x >= 0; two fixed-point steps
+            # a <- ((x + s sqrt(a)) / kc)^(1/gamma) from it stay below the root and near it
+            hertz = (xp / kc) ** (1.0 / g0)
+            a = torch.maximum(hertz, a_t)
+            for _ in range(2):
+                a = ((xp + s * torch.sqrt(a)) / kc) ** (1.0 / g0)
+            # for x < 0 the root lies in [a_d, a0): start at a0, right of it
+            a = torch.where(x0 >= 0, a, a_t)
+            a = torch.broadcast_to(a, shape).clone()
         tiny = 4.0 * torch.finfo(a.dtype).eps
         for _ in range(NEWTON_STEPS):
             res, slope = residual(a, g0, x0, kc, s)
