@@ -45,7 +45,13 @@ EVAL_SEED = 2002
 
 def config(args, adhesion_input: bool, epochs: int) -> TrainConfig:
     return TrainConfig.adhesive(
-        epochs=epochs, batch_size=args.batch_size, lr=args.lr, adhesion_input=adhesion_input
+        epochs=epochs,
+        batch_size=args.batch_size,
+        lr=args.lr,
+        adhesion_input=adhesion_input,
+        lambda_start=args.lambda_start,
+        curriculum_epochs=min(args.curriculum_epochs, epochs),
+        physics_steps=args.physics_steps,
     )
 
 
@@ -163,6 +169,11 @@ def main() -> None:
     ap.add_argument("--batch-size", type=int, default=1024)
     ap.add_argument("--lr", type=float, default=7e-4)
     ap.add_argument("--eval-cells", type=int, default=2000)
+    ap.add_argument(
+        "--lambda-start", type=float, default=0.0, help="the parameter anchor (cut targets' cells)"
+    )
+    ap.add_argument("--curriculum-epochs", type=int, default=0)
+    ap.add_argument("--physics-steps", type=int, default=64)
     ap.add_argument("--evaluate-only", action="store_true")
     ap.add_argument("--variants", nargs="+", choices=list(VARIANTS), default=list(VARIANTS))
     ap.add_argument("--train", choices=list(VARIANTS), help=argparse.SUPPRESS)
