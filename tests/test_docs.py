@@ -1,9 +1,12 @@
 """The documentation builds, warnings-free, with every tutorial executed (docs/).
 
-The full build runs the tutorials (about two CPU-minutes), so it is the longest test of the
-fast suite; it is in it on purpose: a broken example, a public name without a docstring or a
-dead cross-reference fails the test command, not a later docs deployment. Its notebooks run
-side by side, one per core, before the build (``_EXECUTE``), which takes their outputs.
+The full build runs the tutorials (minutes of CPU), so it is marked ``docs`` and kept out of
+the default run (``python -m pytest -q``); CI runs it as a step of its own right after
+(``python -m pytest -q -m docs -n 0``, in .ci/run), so a broken example or a dead
+cross-reference still fails CI, not a later docs deployment. The other tests here (a
+docstring for every public name, a dead reference or a broken example failing a one-page
+build) stay in the default run. The build's notebooks run side by side, one per core, before
+the build (``_EXECUTE``), which takes their outputs.
 """
 
 from __future__ import annotations
@@ -90,6 +93,7 @@ sys.exit(1 if run.errored or run.excepted or len(run.succeeded) != len(pages) el
 """
 
 
+@pytest.mark.docs
 def test_the_docs_build_warnings_free_with_every_tutorial_run(tmp_path):
     # The notebooks run first, in parallel, into a cache under the build folder; the build
     # takes their outputs from it (nb_execution_mode "cache": a page whose code is not in the
