@@ -168,10 +168,11 @@ def design(
                     fallback=True,
                 )
             results[i] = replace(r, seconds=r.seconds + extra)
-    if refine_designs and perturb is None:  # asperities idle over the target put to use
+    rs = refine_settings or RefineSettings()
+    if refine_designs and perturb is None and rs.reseed:  # idle asperities put to use
         from metainterface.inverse.reseed import reseed
 
-        results = reseed(results, refine_settings or RefineSettings(), extra_loss, model, seed)
+        results = reseed(results, rs, extra_loss, model, seed)
     if z_step is not None:
         results = printable(
             results, z_step, refine_settings or RefineSettings(), extra_loss, model, perturb, dev

@@ -91,6 +91,10 @@ class RefineSettings:
     # kinks where asperities engage, and where a refinement stops there moves with the last
     # bits of the start.
     tol_error: float = 1e-5
+    # Designs with asperities idle over the target's range get re-seeded starts
+    # (``inverse.reseed``), as costly as the design itself; a scale search's quick candidates
+    # skip them (they rank scales; the chosen one is designed in full, re-seed included)
+    reseed: bool = True
 
     def __post_init__(self) -> None:
         if self.polish_method not in POLISH_METHODS:

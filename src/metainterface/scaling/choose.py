@@ -22,8 +22,12 @@ from metainterface.scaling import search as _scale
 
 #: Candidate scales designed quickly before the chosen one is designed in full.
 CANDIDATES = 5
-#: The quick design of each candidate: a short refinement, no fallback multistart.
-QUICK = RefineSettings(stages=2, steps_per_stage=3, iterations=20, polish_iterations=20)
+#: The quick design of each candidate: a short refinement, no fallback multistart, no
+#: re-seeding of idle asperities (it cost as much as the candidates' designs, and the
+#: chosen scale's full design re-seeds; ``benchmarks/results/loaded.md``).
+QUICK = RefineSettings(
+    stages=2, steps_per_stage=3, iterations=20, polish_iterations=20, reseed=False
+)
 #: Options of the three scale variables, as the error messages name them.
 _OPTIONS = {"area": "area", "modulus": "modulus", "shear_strength": "shear_strength"}
 
