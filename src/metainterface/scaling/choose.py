@@ -277,9 +277,9 @@ def design_scale(
     One of area, modulus, shear_strength is 'auto' or a range ('2cm2..10cm2'; area defaults
     to 'auto'), the others fixed. The scales that make the law reachable are found
     (:func:`feasible_scale`); ``candidates`` values spread over them (or, where none is
-    reachable, around the closest) are each designed with a short refinement, in one batch,
-    then up to three more between the best and its neighbours; the one
-    with the smallest error is designed in full with ``options`` (as
+    reachable, around the closest) are each designed with a short refinement (no
+    re-seeding), in one batch, then up to three more between the best and its neighbours;
+    the one with the smallest error is designed in full with ``options`` (as
     :func:`~metainterface.design`, e.g. ``method``, ``seed``, ``out``).
 
     A candidate's score is its quick design's relative curve error plus the share of the
