@@ -1,6 +1,9 @@
 """Asperities that never touch over the target's range are re-seeded and put to use."""
 
+from dataclasses import replace
+
 import numpy as np
+import pytest
 import torch
 
 import metainterface as mi
@@ -63,3 +66,20 @@ def test_a_design_with_an_idle_asperity_is_re_seeded_no_worse():
     full = DesignResult(target, "surrogate", gamma[0].numpy(), h[0].numpy(), 0.0, 0.0, 0.0, S)
     assert reseed([full], RefineSettings(), None, MODEL, seed=0)[0] is full
     assert np.all(np.isfinite(out.gamma))
+
+
+def test_refine_settings_can_leave_the_re_seeding_out(monkeypatch):
+    # a scale search's quick candidates rank scales: they are not re-seeded (the chosen
+    # scale's full design is)
+    import metainterface.inverse.reseed as reseed_module
+    from metainterface.inverse import pipeline
+    from metainterface.scaling.choose import QUICK
+
+    assert RefineSettings().reseed and not QUICK.reseed
+    monkeypatch.setattr(reseed_module, "reseed", lambda *a, **k: pytest.fail("re-seeded"))
+    quick = RefineSettings(stages=1, steps_per_stage=1, iterations=2, polish_iterations=0)
+    target = mi.Target.builtin("bilinear")
+    (r,) = pipeline.design([target], refine_settings=replace(quick, reseed=False))
+    assert np.isfinite(r.error)
+    with pytest.raises(pytest.fail.Exception, match="re-seeded"):
+        pipeline.design([target], refine_settings=quick)
