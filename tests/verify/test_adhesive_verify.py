@@ -18,22 +18,30 @@ W = 0.05 / (2.4e6 * 0.5e-3)
 QUICK = mi.Effort(refine=False, seed=0)
 
 
-@pytest.fixture(scope="module")
-def sticky_target():
-    """The loading curve of a held-back adhesive cell (16 loads from zero)."""
+def _held_back(seed: int, spread: float, loads: int, top: float):
+    """A random adhesive cell (heights in [0, spread] Delta_max) and its own loading curve
+    under Independent(adhesion=W), ``loads`` loads from zero to ``top`` of its reach."""
+    from metainterface.physics import Design
+
     s = CellSettings()
-    rng = np.random.default_rng(3)
+    rng = np.random.default_rng(seed)
     g = rng.uniform(1.8, 4.0, 9)
-    h = rng.uniform(0, 0.6, 9) * s.delta_max
+    h = rng.uniform(0, spread, 9) * s.delta_max
     h -= h.min()
     model = mi.Independent(adhesion=W)
     gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
     with torch.no_grad():
         p_max = float(model.sweep(gt, ht, s).p_star[0, -1])
-        p = np.linspace(0, 0.9 * p_max, 16)
+        p = np.linspace(0, top * p_max, loads)
         p[0] = 1e-12 * p_max
         a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
-    return mi.Target(p_star=p, alpha=a, name="sticky")
+    return Design(gamma=g, h=h, settings=s), mi.Target(p_star=p, alpha=a, name="sticky")
+
+
+@pytest.fixture(scope="module")
+def sticky_target():
+    """The loading curve of a held-back adhesive cell (16 loads from zero)."""
+    return _held_back(3, 0.6, 16, 0.9)[1]
 
 
 @pytest.fixture(scope="module")
@@ -115,23 +123,10 @@ def test_states_a_rising_force_jumps_over_are_not_compared():
     # asperity in contact at a load below the one the cell carried before that touch: a
     # rising force jumps over it. The samples' running maximum misses that peak; the check
     # must not compare there (it read +70 % against the model at 96^2 before).
-    from metainterface.physics import Design
     from metainterface.verify.check import bem_check
 
-    s = CellSettings()
-    rng = np.random.default_rng(0)
-    g = rng.uniform(1.8, 4.0, 9)
-    h = rng.uniform(0, 0.3, 9) * s.delta_max
-    h -= h.min()
-    design = Design(gamma=g, h=h, settings=s)
+    design, target = _held_back(0, 0.3, 24, 0.95)
     model = mi.Independent(adhesion=W)
-    gt, ht = design.tensors(torch.float64)
-    with torch.no_grad():
-        p_max = float(model.sweep(gt, ht, s).p_star[0, -1])
-        p = np.linspace(0, 0.95 * p_max, 24)
-        p[0] = 1e-12 * p_max
-        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
-    target = mi.Target(p_star=p, alpha=a, name="own curve")
     check = bem_check(design, target, mi.Verify(grid=96, loads=12, correct=False), model)
     assert check.p_star.size >= 10
     # every compared state is on the model's loading curve to within the 96^2 grid's error
