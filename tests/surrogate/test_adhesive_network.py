@@ -134,3 +134,13 @@ def test_the_shipped_adhesive_network_reads_adhesive_targets_better(tmp_path):
                 labels.append(res.zero_shot_from)
     assert np.median(errs["shipped"]) < 0.7 * np.median(errs["alone"])  # 5.6 % against 10 %
     assert any(label.startswith("adhesive network") for label in labels)
+
+
+@pytest.mark.skipif(not default_adhesive_model_path().is_file(), reason="no shipped network")
+def test_an_adhesive_network_given_for_an_adhesionless_design_is_refused():
+    effort = mi.Effort(refine=False, surrogate=str(default_adhesive_model_path()))
+    with pytest.raises(MetainterfaceError, match="reads a work of adhesion"):
+        mi.design("bilinear", verify=False, effort=effort)
+    # with an adhesive model it designs (the network told the model's w)
+    r = mi.design("bilinear", model=mi.Independent(adhesion=4.2e-5), verify=False, effort=effort)
+    assert np.isfinite(r.error)

@@ -365,6 +365,13 @@ def _zero_shot(
     from metainterface.surrogate.checkpoint import default_model_path, design_model
 
     net, settings, _ = design_model(model_path or default_model_path())
+    if net.adhesion_input and not model.adhesion:
+        raise MetainterfaceError(
+            f"the surrogate {model_path} reads a work of adhesion (an adhesive network): "
+            "design with a model that has adhesion (model=Independent(adhesion=w), "
+            "--work-of-adhesion) or give an adhesionless surrogate",
+            argument="surrogate",
+        )
     gamma0, h0 = predict(net, targets, settings, adhesion=model.adhesion)
     laws_net = shipped_laws_net(model_path, settings, targets)
     adhesive_net = shipped_adhesive_net(model_path, settings, model)
