@@ -198,18 +198,15 @@ class ForwardModel(ABC):
         return jkr.pull_off(gamma, h, settings, self.adhesion, kernel=kernel, **self._jkr_opts())
 
     def touch_loads(self, design: Design) -> np.ndarray:
-        """(N,) P* one design carries, loaded by approach, just before each asperity touches
-        (``physics.adhesion.touch_loads``): a state under a rising force with asperity i in
-        contact carries at least the i-th. Zeros without adhesion (no snap-in)."""
+        """(N,) the largest P* of one design, loaded by approach, before each asperity touches
+        (``physics.adhesion.touch_loads``; zeros without adhesion: no snap-in)."""
         gamma, h = design.tensors(torch.float64)
         if not self.adhesion:
             return np.zeros(gamma.shape[-1])
         kernel = self.adhesion_kernel(design.settings, gamma.dtype, gamma.device)
+        opts = {"kernel": kernel, **self._jkr_opts()}
         with torch.no_grad():
-            loads = jkr.touch_loads(
-                gamma, h, design.settings, self.adhesion, kernel=kernel, **self._jkr_opts()
-            )
-        return loads[0].numpy()
+            return jkr.touch_loads(gamma, h, design.settings, self.adhesion, **opts)[0].numpy()
 
     def design_pull_off(self, design: Design) -> float:
         """The pull-off pressure P*_off of one design (see :meth:`pull_off`)."""
