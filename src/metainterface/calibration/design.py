@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from metainterface.calibration.sphere import Calibration
+from metainterface.calibration.sphere import Calibration, check_scales, friction_rows
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.models import ForwardModel, get_model
 
@@ -152,23 +152,8 @@ def calibrate_design(
     """
     from metainterface.physics.jkr import ADHESION_LIMIT
 
-    for name, value in (("modulus E*", e_star), ("area", area), ("radius", radius)):
-        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
-            raise MetainterfaceError(f"{name} must be finite and > 0, got {value!r}")
-    fn = np.asarray(normal_force, dtype=np.float64)
-    ff = np.asarray(friction_force, dtype=np.float64)
-    if np.any(fn[np.isfinite(fn)] < 0):
-        raise MetainterfaceError(
-            f"{source}: a made design's calibration takes loads >= 0 (the loading branch), "
-            f"got {float(np.nanmin(fn)):g} N"
-        )
-    keep = np.isfinite(fn) & np.isfinite(ff) & (ff > 0)
-    fn, ff = fn[keep], ff[keep]
-    if fn.size < 3:
-        raise MetainterfaceError(
-            f"{source}: calibrating tau and w needs at least 3 rows with friction > 0, "
-            f"got {fn.size}"
-        )
+    check_scales((("modulus E*", e_star), ("area", area), ("radius", radius)))
+    fn, ff = friction_rows(normal_force, friction_force, source, loading=True)
     unit = e_star * radius  # w [J/m^2] = w [E* R] * unit
 
     adhesive_model(model, 0.0)  # a model that takes no adhesion: one line, before the fit

@@ -123,6 +123,36 @@ class Calibration:
         }
 
 
+def check_scales(named: tuple[tuple[str, object], ...]) -> None:
+    """A one-line error for the first (name, value) that is not a finite number > 0."""
+    for name, value in named:
+        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+            raise MetainterfaceError(f"{name} must be finite and > 0, got {value!r}")
+
+
+def friction_rows(
+    normal_force: np.ndarray, friction_force: np.ndarray, source: str, *, loading: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """A friction test's rows (K,) [N] as float arrays, those with both finite and friction
+    > 0 kept; a one-line error for fewer than 3, and (``loading``: a made design's loading
+    branch) for a negative load."""
+    fn = np.asarray(normal_force, dtype=np.float64)
+    ff = np.asarray(friction_force, dtype=np.float64)
+    if loading and np.any(fn[np.isfinite(fn)] < 0):
+        raise MetainterfaceError(
+            f"{source}: a made design's calibration takes loads >= 0 (the loading branch), "
+            f"got {float(np.nanmin(fn)):g} N"
+        )
+    keep = np.isfinite(fn) & np.isfinite(ff) & (ff > 0)
+    fn, ff = fn[keep], ff[keep]
+    if fn.size < 3:
+        raise MetainterfaceError(
+            f"{source}: calibrating tau and w needs at least 3 rows with friction > 0, "
+            f"got {fn.size}"
+        )
+    return fn, ff
+
+
 def calibrate_sphere(
     normal_force: np.ndarray,
     friction_force: np.ndarray,
@@ -137,18 +167,8 @@ def calibrate_sphere(
     """
     from scipy.optimize import least_squares
 
-    for name, value in (("sphere radius", radius), ("modulus E*", e_star)):
-        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
-            raise MetainterfaceError(f"{name} must be finite and > 0, got {value!r}")
-    fn = np.asarray(normal_force, dtype=np.float64)
-    ff = np.asarray(friction_force, dtype=np.float64)
-    keep = np.isfinite(fn) & np.isfinite(ff) & (ff > 0)
-    fn, ff = fn[keep], ff[keep]
-    if fn.size < 3:
-        raise MetainterfaceError(
-            f"{source}: calibrating tau and w needs at least 3 rows with friction > 0, "
-            f"got {fn.size}"
-        )
+    check_scales((("sphere radius", radius), ("modulus E*", e_star)))
+    fn, ff = friction_rows(normal_force, friction_force, source)
     # scales: tau from the largest load's Hertz area; w from the force scale F / (pi R)
     a_top = jkr_contact_radius(np.array([max(fn.max(), 1e-300)]), 0.0, radius, e_star)[0]
     tau0 = float(ff.max() / (math.pi * a_top**2)) if a_top > 0 else 1.0
