@@ -202,18 +202,11 @@ def shipped_adhesive_net(
 ) -> InverseMLP | None:
     """The shipped adhesive network (``surrogate.adhesive``) where the model has adhesion,
     the shipped surrogate designs and the network is there for the same cell; else None."""
-    from metainterface.surrogate.checkpoint import (
-        default_adhesive_model_path,
-        default_model_path,
-        design_model,
-    )
+    from metainterface.surrogate.checkpoint import default_adhesive_model_path
 
-    shipped = model_path is None or Path(model_path).resolve() == default_model_path().resolve()
-    path = default_adhesive_model_path()
-    if not model.adhesion or not shipped or not path.is_file():
+    if not model.adhesion:
         return None
-    net, trained, _ = design_model(path)
-    return net if trained == settings else None
+    return _beside_shipped(model_path, default_adhesive_model_path(), settings)
 
 
 def shipped_laws_net(
@@ -222,15 +215,22 @@ def shipped_laws_net(
     """The shipped friction-law network, where the shipped surrogate designs targets without
     stiffness and the network is there (and made for the same cell); else None. A surrogate
     of the user's own is used alone: the shipped laws network was fine-tuned from ours."""
-    from metainterface.surrogate.checkpoint import (
-        default_laws_model_path,
-        default_model_path,
-        design_model,
-    )
+    from metainterface.surrogate.checkpoint import default_laws_model_path
+
+    if all(t.stiffness is not None for t in targets):
+        return None
+    return _beside_shipped(model_path, default_laws_model_path(), settings)
+
+
+def _beside_shipped(
+    model_path: str | os.PathLike[str] | None, path: Path, settings: CellSettings
+) -> InverseMLP | None:
+    """The shipped network at ``path`` where the design uses the shipped surrogate (None, or
+    its path) and that network is there for the same cell; else None."""
+    from metainterface.surrogate.checkpoint import default_model_path, design_model
 
     shipped = model_path is None or Path(model_path).resolve() == default_model_path().resolve()
-    path = default_laws_model_path()
-    if not shipped or not path.is_file() or all(t.stiffness is not None for t in targets):
+    if not shipped or not path.is_file():
         return None
     net, trained, _ = design_model(path)
     return net if trained == settings else None

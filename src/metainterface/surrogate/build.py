@@ -150,15 +150,12 @@ def evaluate_surrogate(
             train_split = law_split(train_split, settings, LAW_SEEDS[0], progress=progress)
             test_split = law_split(test_split, settings, LAW_SEEDS[1], progress=progress)
     elif reads == "adhesive":
-        from metainterface.surrogate.adhesive import AdhesiveTargets, adhesive_split
+        from metainterface.surrogate.adhesive import adhesive_split
 
         reads_w = bool(config.get("model", {}).get("adhesion_input", False))
-        once = AdhesiveTargets(copies=1)  # one target a cell: a test set of the split's size
         with torch.inference_mode():
             train_split, test_split = (
-                adhesive_split(
-                    part, settings, seed, adhesion_input=reads_w, spec=once, progress=progress
-                )
+                adhesive_split(part, settings, seed, adhesion_input=reads_w, progress=progress)
                 for part, seed in zip((train_split, test_split), LAW_SEEDS, strict=True)
             )
     return evaluate(model, train_split, test_split, settings, weights_of(config), reads)

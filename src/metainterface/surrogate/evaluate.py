@@ -61,24 +61,22 @@ def predict_split(
             if split.adhesion is not None:  # adhesive targets: their loading curves
                 w = split.adhesion_rows(idx)
                 errs.append(adhesive_error(gamma, h, t, settings, w, n_delta=512).numpy())
-                nan = np.full(len(idx), np.nan)
-                lp.append(nan)
-                la.append(nan)
-                gs.append(gamma.numpy())
-                hs.append(h.numpy())
-                continue
-            p_grid = (
-                torch.linspace(0, 1, settings.n_steps, dtype=torch.float64)[None]
-                * t.p_star_max.double()[:, None]
-            )
-            alpha_true = t.alpha_hat.double() * t.alpha_max.double()[:, None]
-            alpha_pred, _ = alpha_at(gamma, h, settings, p_grid, exact=exact)
-            errs.append(relative_l2(alpha_pred, alpha_true).numpy())
-            c = curve(gamma, h, settings)
-            lp.append(
-                (torch.log10(c.p_star_max) - torch.log10(t.p_star_max.double())).abs().numpy()
-            )
-            la.append((torch.log10(c.alpha_max) - torch.log10(t.alpha_max.double())).abs().numpy())
+                lp.append(np.full(len(idx), np.nan))
+                la.append(np.full(len(idx), np.nan))
+            else:
+                p_grid = (
+                    torch.linspace(0, 1, settings.n_steps, dtype=torch.float64)[None]
+                    * t.p_star_max.double()[:, None]
+                )
+                alpha_true = t.alpha_hat.double() * t.alpha_max.double()[:, None]
+                alpha_pred, _ = alpha_at(gamma, h, settings, p_grid, exact=exact)
+                errs.append(relative_l2(alpha_pred, alpha_true).numpy())
+                c = curve(gamma, h, settings)
+                for out, have, want in (
+                    (lp, c.p_star_max, t.p_star_max),
+                    (la, c.alpha_max, t.alpha_max),
+                ):
+                    out.append((torch.log10(have) - torch.log10(want.double())).abs().numpy())
             gs.append(gamma.numpy())
             hs.append(h.numpy())
     cat = np.concatenate
