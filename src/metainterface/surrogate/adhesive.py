@@ -38,7 +38,7 @@ from metainterface.physics.curves import features_from_normalised, normalised_fr
 from metainterface.physics.jkr import ADHESION_LIMIT
 from metainterface.physics.metrics import interp, relative_l2
 from metainterface.surrogate.data import Split
-from metainterface.surrogate.laws import ROWS
+from metainterface.surrogate.laws import ROWS, check_counts
 from metainterface.surrogate.loss import CurveTargets
 from metainterface.surrogate.model import adhesion_column
 
@@ -68,21 +68,12 @@ class AdhesiveTargets:
     delta_samples: int = 256
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.copies, int) and 1 <= self.copies <= 100):
-            raise MetainterfaceError(
-                f"copies must be a whole number in [1, 100], got {self.copies}"
-            )
+        check_counts(self.copies, self.min_end, self.delta_samples)
         lo, hi = self.adhesion
         if not 0 < lo <= hi <= ADHESION_LIMIT:
             raise MetainterfaceError(
                 f"adhesion must be a range within (0, {ADHESION_LIMIT:g}] (E* R), got "
                 f"{self.adhesion}"
-            )
-        if not 0 < self.min_end <= 1:
-            raise MetainterfaceError(f"min_end must be in (0, 1], got {self.min_end}")
-        if not 8 <= self.delta_samples <= 100_000:
-            raise MetainterfaceError(
-                f"delta_samples must be in [8, 100000], got {self.delta_samples}"
             )
 
 

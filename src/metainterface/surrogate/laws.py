@@ -71,22 +71,24 @@ class LawTargets:
     delta_samples: int = 256
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.copies, int) and 1 <= self.copies <= 100):
-            raise MetainterfaceError(
-                f"copies must be a whole number in [1, 100], got {self.copies}"
-            )
-        if not 0 < self.min_end <= 1:
-            raise MetainterfaceError(f"min_end must be in (0, 1], got {self.min_end}")
+        check_counts(self.copies, self.min_end, self.delta_samples)
         if not 0 <= self.warp <= 0.9:
             raise MetainterfaceError(f"warp must be in [0, 0.9], got {self.warp}")
         if len(self.shares) != 3 or min(self.shares) < 0 or sum(self.shares) <= 0:
             raise MetainterfaceError(
                 f"shares must be three numbers >= 0 with a positive sum, got {self.shares}"
             )
-        if not 8 <= self.delta_samples <= 100_000:
-            raise MetainterfaceError(
-                f"delta_samples must be in [8, 100000], got {self.delta_samples}"
-            )
+
+
+def check_counts(copies: object, min_end: float, delta_samples: int) -> None:
+    """The settings every kind of made target shares (``LawTargets``,
+    ``adhesive.AdhesiveTargets``): a one-line error for the first out of range."""
+    if not (isinstance(copies, int) and 1 <= copies <= 100):
+        raise MetainterfaceError(f"copies must be a whole number in [1, 100], got {copies}")
+    if not 0 < min_end <= 1:
+        raise MetainterfaceError(f"min_end must be in (0, 1], got {min_end}")
+    if not 8 <= delta_samples <= 100_000:
+        raise MetainterfaceError(f"delta_samples must be in [8, 100000], got {delta_samples}")
 
 
 def law_split(
