@@ -58,9 +58,9 @@ def approaches(design: Design, model: ForwardModel, top: float, k: int) -> np.nd
 
 
 def clear_of_snap_ins(p_star: np.ndarray, touching: np.ndarray, peaks: np.ndarray) -> np.ndarray:
-    """(K,) bool: the BEM states (P* (K,), asperities in contact (K, N)) that a rising force
-    reaches and that lie clear of the model's snap-ins (``peaks`` (N,), the model's
-    ``touch_loads``), the states the check compares.
+    """(K,) bool: the BEM states (P* (K,), asperities in contact (K, N)) clear of the model's
+    snap-ins (``peaks`` (N,), the model's ``touch_loads``); with the path's ``on_branch``,
+    the states the check compares.
 
     A state with asperity i in contact below the load the cell had just before i touched
     was met by approach only: a rising force jumps over it (the sampled running maximum
