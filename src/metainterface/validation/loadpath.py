@@ -17,7 +17,7 @@ from metainterface.errors import MetainterfaceError
 
 #: Convergence tolerance of the Polonsky-Keer-Rey solver (the paper's value).
 TOLERANCE = 1e-11
-#: Iteration cap per solve (Tamaas's default). 768^2 cells converge in ~110 iterations.
+#: Iteration cap per solve (Tamaas's default; the torch engine takes a few tens at 768^2).
 MAX_ITER = 1000
 
 INSTALL_HINT = "pip install 'metainterface[bem]'"
