@@ -75,3 +75,24 @@ def test_a_subpackage_never_hides_a_public_function():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "True"
+
+
+def test_the_console_script_exits_with_its_status_and_all_its_output(tmp_path):
+    """``python -m metainterface`` ends without Python's slow teardown (``cli.run``): its exit
+    status, its printed line and its file are those of ``main``, and a pipe closed by the
+    reader (``| head -c 5``) is no error."""
+    from importlib.resources import files
+
+    example = str(files("metainterface") / "examples" / "example_design.json")
+    out = tmp_path / "curve.csv"
+    run = [sys.executable, "-m", "metainterface", "curve", example, "--out", str(out)]
+    done = subprocess.run([*run, "--steps", "50"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    rows = [r for r in out.read_text().splitlines() if r[:1].isdigit()]
+    assert len(rows) == 50 and done.stdout.startswith(f"{out}: 50 points")
+    bad = subprocess.run([*run, "--steps", "0"], capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1
+    piped = subprocess.run(
+        f"{' '.join(run)} --steps 50 | head -c 5", shell=True, capture_output=True, text=True
+    )
+    assert piped.returncode == 0 and piped.stdout == str(out)[:5] and piped.stderr == ""

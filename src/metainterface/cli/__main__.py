@@ -1,7 +1,5 @@
 """`python -m metainterface.cli ...` runs the command line."""
 
-import sys
+from metainterface.cli import run
 
-from metainterface.cli import main
-
-sys.exit(main())
+run()
