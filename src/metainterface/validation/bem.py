@@ -67,6 +67,7 @@ def solve_path(
     total: int | None = None,
     report: Callable[[int], Any] | None = None,
     fields: bool = False,
+    contact_depth: np.ndarray | None = None,
 ) -> LoadPath:
     """Solve the contact of one cell at ascending mean pressures ``loads`` (K,) [P* = P/E*].
 
@@ -77,8 +78,11 @@ def solve_path(
     uniform pressure, each next one from the previous solution. ``report(1)`` is called
     after each load. ``first_index`` and ``total`` only number the loads in error messages
     (for chunks of a longer path). fields: also keep the pressure and gap fields of every
-    load (``LoadPath.pressures``, ``gaps``; 2 K M^2 floats). Raises MetainterfaceError
-    naming the load and the residual if a solve does not converge.
+    load (``LoadPath.pressures``, ``gaps``; 2 K M^2 floats). contact_depth: (N,) where a
+    forward model puts each asperity's contact edge at the first load, as its depth below
+    the tip, c a^gamma [length]: the torch engine starts there (``torch_bem.contact_start``)
+    instead of from a uniform pressure. Raises MetainterfaceError naming the load and the
+    residual if a solve does not converge.
     """
     from metainterface.validation.solvers import get_engine
 
@@ -96,6 +100,7 @@ def solve_path(
         fields=fields,
         device=device,
         threads=threads,
+        contact_depth=contact_depth,
     )
 
 
@@ -247,12 +252,14 @@ def solve_loads(
     weights: np.ndarray | None = None,
     progress: Callable[[int], Any] | None = None,
     fields: bool = False,
+    contact_depths: np.ndarray | None = None,
 ) -> LoadPath:
     """One cell's load path (K,), split into ``jobs`` contiguous warm-started chunks.
 
-    Each chunk starts from zero traction and then follows its own part of the path; the
-    solution is unique, so chunking changes results only within the tolerance. weights: (K,)
-    expected relative cost of each load, to balance the chunks (default: equal).
+    Each chunk starts afresh (from ``contact_depths[first load]`` (K, N) if given, see
+    ``solve_path``) and then follows its own part of the path; the solution is unique, so
+    chunking changes results only within the tolerance. weights: (K,) expected relative
+    cost of each load, to balance the chunks (default: equal).
     """
     loads = np.asarray(loads, dtype=np.float64)
     chunks = split_path(len(loads), jobs, weights)
@@ -268,6 +275,14 @@ def solve_loads(
         total=len(loads),
         fields=fields,
     )
-    tasks = [{**common, "loads": loads[c], "first_index": int(c[0])} for c in chunks]
+    tasks = [
+        {
+            **common,
+            "loads": loads[c],
+            "first_index": int(c[0]),
+            "contact_depth": None if contact_depths is None else contact_depths[c[0]],
+        }
+        for c in chunks
+    ]
     parts = run_tasks(tasks, jobs, progress=progress)
     return LoadPath.concat([p for p in parts if p is not None])

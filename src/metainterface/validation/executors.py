@@ -52,6 +52,8 @@ class BemTask:
     engine: str = "torch"
     device: str = "auto"
     threads: int | None = 1
+    #: (N,) the forward model's contact edges at the first load (``bem.solve_path``)
+    contact_depth: np.ndarray | None = None
 
 
 def solve_task(task: BemTask) -> LoadPath:
@@ -75,6 +77,7 @@ def solve_task(task: BemTask) -> LoadPath:
         engine=task.engine,
         device=task.device,
         threads=task.threads,
+        contact_depth=task.contact_depth,
     )
 
 

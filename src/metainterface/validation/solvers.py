@@ -73,6 +73,7 @@ class Engine(Protocol):
         fields: bool = False,
         device: Any = "auto",
         threads: int | None = None,
+        contact_depth: np.ndarray | None = None,
     ) -> LoadPath:
         """As ``bem.solve_path``."""
 
@@ -94,7 +95,14 @@ class TamaasEngine:
                 argument="device",
             )
 
-    def solve_path(self, *args: Any, device: Any = "auto", threads: int | None = None, **kw: Any):
+    def solve_path(
+        self,
+        *args: Any,
+        device: Any = "auto",
+        threads: int | None = None,
+        contact_depth: np.ndarray | None = None,  # Tamaas starts from its own guess
+        **kw: Any,
+    ) -> LoadPath:
         self.check(device)
         return tamaas_path(*args, **kw)
 
@@ -127,6 +135,7 @@ class TorchEngine:
         fields: bool = False,
         device: Any = "auto",
         threads: int | None = None,
+        contact_depth: np.ndarray | None = None,
     ) -> LoadPath:
         from metainterface._device import resolve_device
         from metainterface.validation import torch_bem
@@ -143,6 +152,9 @@ class TorchEngine:
                 report(1)
 
         with torch_threads(threads):
+            start = None
+            if contact_depth is not None:
+                start = torch_bem.contact_start(heights, owner, contact_depth)
             try:
                 torch_bem.solve_path(
                     heights,
@@ -152,6 +164,7 @@ class TorchEngine:
                     tolerance=tolerance,
                     max_iter=max_iter,
                     on_load=on_load,
+                    start=start,
                 )
             except ArithmeticError as exc:
                 i, why = exc.args

@@ -135,6 +135,19 @@ class ValidationPlan:
             engine=self.engine,
         )
 
+    def contact_depths(self, curve: ModelCurve | None = None) -> np.ndarray | None:
+        """(K, N) where the model puts each asperity's contact edge at each load, as its
+        depth below the tip, c a^gamma [length] (a solve's first guess, ``bem.solve_path``);
+        None if the model does not resolve the asperities."""
+        curve = self.model_curve() if curve is None else curve
+        _, per = curve.at(self.loads)
+        if per is None:
+            return None
+        s = self.design.settings
+        radius = np.sqrt(np.clip(per, 0.0, None) * s.nominal_area / np.pi)  # a = sqrt(A / pi)
+        gamma = np.asarray(self.design.gamma, dtype=np.float64)
+        return radius**gamma / (2.0 * s.radius ** (gamma - 1.0))  # c a^gamma
+
     def load_weights(self, curve: ModelCurve | None = None) -> np.ndarray:
         """(K,) expected relative cost of each load, to balance a path's chunks."""
         curve = self.model_curve() if curve is None else curve
@@ -154,6 +167,7 @@ class ValidationPlan:
         runs on ``threads`` threads in the worker (None: as set there)."""
         weights = self.load_weights(curve) if chunks > 1 else None
         parts = split_path(len(self.loads), chunks, weights)
+        depths = self.contact_depths(curve) if self.engine == "torch" else None
         return [
             BemTask(
                 design=self.design,
@@ -167,6 +181,7 @@ class ValidationPlan:
                 engine=self.engine,
                 device=self.device,
                 threads=threads,
+                contact_depth=None if depths is None else depths[c[0]],
             )
             for c in parts
         ]
@@ -198,6 +213,7 @@ class ValidationPlan:
                 weights=self.load_weights(curve),
                 progress=progress,
                 fields=fields,
+                contact_depths=self.contact_depths(curve) if self.engine == "torch" else None,
             )
             return self.result(path, heights=heights, curve=curve)
         tasks = self.tasks(jobs, fields=fields, curve=curve)
