@@ -147,8 +147,8 @@ def compute_envelope(
     reached = grid[None] <= p_max[:, None]
     lo = torch.where(reached, alpha, torch.inf).amin(0)
     hi = torch.where(reached, alpha, -torch.inf).amax(0)
-    as64 = [v.numpy().astype(np.float64) for v in (grid, lo, hi)]
-    return as64[0], as64[1], as64[2], reach
+    grid_np, lo_np, hi_np = (v.numpy().astype(np.float64) for v in (grid, lo, hi))
+    return grid_np, lo_np, hi_np, reach
 
 
 def reach_violation(

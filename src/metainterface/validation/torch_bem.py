@@ -150,8 +150,7 @@ def solve_batch(
     rows = torch.arange(b, device=dev)  # the items still iterating, as rows of the originals
     z, ker, tgt, nrm = heights, kernel, target, norm
     # the preconditioner: the half-space's stiffness, the compliance's inverse (0 at k = 0)
-    stiff = torch.where(kernel > 0, kernel.reciprocal(), 0.0)
-    stf = stiff
+    stf = torch.where(kernel > 0, kernel.reciprocal(), 0.0)
     t = torch.zeros_like(p)
     g_old = torch.ones(b, 1, 1, dtype=torch.float64, device=dev)
     conjugate = torch.zeros(b, 1, 1, dtype=torch.bool, device=dev)
@@ -241,7 +240,7 @@ def solve_path(
     every = (1 if device.type == "cpu" else 4) if check_every is None else check_every
     p = None if start is None else torch.as_tensor(start, device=device).reshape(1, m, m)
     for i, load in enumerate(np.asarray(loads, dtype=np.float64)):
-        start = time.perf_counter()
+        t0 = time.perf_counter()
         target = torch.tensor([load], dtype=torch.float64, device=device)
         try:
             try:
@@ -265,7 +264,7 @@ def solve_path(
         except ArithmeticError as exc:
             raise ArithmeticError(i, str(exc)) from None
         pressure, gap_np = p[0].cpu().numpy(), gap[0].cpu().numpy()
-        on_load(i, pressure, gap_np, float(err[0]), time.perf_counter() - start)
+        on_load(i, pressure, gap_np, float(err[0]), time.perf_counter() - t0)
 
 
 def solve_paths(

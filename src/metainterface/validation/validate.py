@@ -21,12 +21,14 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import torch
 
 from metainterface import _checks
 from metainterface._names import DEFAULT_ENGINE
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, ModelCurve, get_model
+from metainterface.physics.sneddon import shape_constant
 from metainterface.validation.bem import (
     MAX_ITER,
     TOLERANCE,
@@ -137,8 +139,11 @@ class ValidationPlan:
 
     def contact_depths(self, curve: ModelCurve | None = None) -> np.ndarray | None:
         """(K, N) where the model puts each asperity's contact edge at each load, as its
-        depth below the tip, c a^gamma [length] (a solve's first guess, ``bem.solve_path``);
-        None if the model does not resolve the asperities."""
+        depth below the tip, c a^gamma [length] (the torch engine's first guess,
+        ``bem.solve_path``); None for Tamaas (it starts on its own) or a model that does not
+        resolve the asperities."""
+        if self.engine != "torch":
+            return None
         curve = self.model_curve() if curve is None else curve
         _, per = curve.at(self.loads)
         if per is None:
@@ -146,7 +151,7 @@ class ValidationPlan:
         s = self.design.settings
         radius = np.sqrt(np.clip(per, 0.0, None) * s.nominal_area / np.pi)  # a = sqrt(A / pi)
         gamma = np.asarray(self.design.gamma, dtype=np.float64)
-        return radius**gamma / (2.0 * s.radius ** (gamma - 1.0))  # c a^gamma
+        return shape_constant(torch.as_tensor(gamma), s.radius).numpy() * radius**gamma
 
     def load_weights(self, curve: ModelCurve | None = None) -> np.ndarray:
         """(K,) expected relative cost of each load, to balance a path's chunks."""
@@ -167,7 +172,7 @@ class ValidationPlan:
         runs on ``threads`` threads in the worker (None: as set there)."""
         weights = self.load_weights(curve) if chunks > 1 else None
         parts = split_path(len(self.loads), chunks, weights)
-        depths = self.contact_depths(curve) if self.engine == "torch" else None
+        depths = self.contact_depths(curve)
         return [
             BemTask(
                 design=self.design,
@@ -213,7 +218,7 @@ class ValidationPlan:
                 weights=self.load_weights(curve),
                 progress=progress,
                 fields=fields,
-                contact_depths=self.contact_depths(curve) if self.engine == "torch" else None,
+                contact_depths=self.contact_depths(curve),
             )
             return self.result(path, heights=heights, curve=curve)
         tasks = self.tasks(jobs, fields=fields, curve=curve)
