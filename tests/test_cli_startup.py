@@ -1,5 +1,6 @@
 """The command line answers at once: no torch, scipy.stats or plotting before the work starts."""
 
+import os
 import subprocess
 import sys
 
@@ -96,3 +97,12 @@ def test_the_console_script_exits_with_its_status_and_all_its_output(tmp_path):
         f"{' '.join(run)} --steps 50 | head -c 5", shell=True, capture_output=True, text=True
     )
     assert piped.returncode == 0 and piped.stdout == str(out)[:5] and piped.stderr == ""
+    # a reader gone before anything is printed: no traceback, the file written, status 0
+    out.unlink()
+    gone = subprocess.run(
+        ["bash", "-c", f"{' '.join(run)} --steps 50 | true; exit ${{PIPESTATUS[0]}}"],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    assert gone.returncode == 0 and gone.stderr == "" and out.exists()

@@ -133,7 +133,11 @@ def run() -> NoReturn:
     are run (logging, multiprocessing, Dask), the streams flushed, and the process ends at
     once; files were already closed (every write is atomic). With a thread still running,
     Python's ordinary exit waits for it.
+
+    A reader that closes the pipe early (``| head``) ends the printed report, not the
+    command: its files are written and its status stands (``_ReaderMayLeave``).
     """
+    sys.stdout = _ReaderMayLeave(sys.stdout)
     code = main()
     exit_handlers = getattr(atexit, "_run_exitfuncs", None)  # CPython's, run by every exit
     if threading.active_count() > 1 or exit_handlers is None:
@@ -143,6 +147,35 @@ def run() -> NoReturn:
         with contextlib.suppress(OSError, ValueError):  # a pipe closed by `| head`: no loss
             stream.flush()
     os._exit(code)
+
+
+class _ReaderMayLeave:
+    """Standard output whose reader may close the pipe: from the first BrokenPipeError on,
+    what is printed goes to os.devnull (the descriptor too, so that the buffered rest
+    flushes there at exit), instead of a traceback that aborts the command's files."""
+
+    def __init__(self, stream: Any) -> None:
+        self._stream = stream
+
+    def _reader_left(self) -> None:
+        with contextlib.suppress(OSError, ValueError):  # no descriptor: nothing to redirect
+            os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._reader_left()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._reader_left()
+
+    def __getattr__(self, name: str) -> Any:  # encoding, isatty, fileno, buffer, ...
+        return getattr(self._stream, name)
 
 
 @contextlib.contextmanager
