@@ -38,6 +38,9 @@ class Context:
             path = self.out / f"{name}.{suffix}"
             save_figure(fig, path, command=self.command, **record)
             files[suffix] = path.name
+            # the PDF keeps the PNG's layout: laying the text out again costs as much as
+            # drawing it, for the same positions
+            fig.set_layout_engine("none")
         text = (
             f"{caption.strip()}\n\nScale: {self.scale.name}. Made by metainterface "
             f"{__version__}: `{self.command}`.\n"

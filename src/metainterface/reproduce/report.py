@@ -377,6 +377,7 @@ def _settings(scale: Scale, numbers: Mapping[str, Any]) -> list[str]:
             f"{rs.stages} x {rs.steps_per_stage} x {rs.iterations}",
             "5 x 5 x 20",
         ],
+        ["polish iterations after the stages (ours)", rs.polish_iterations, "none"],
     ]
     if "fig6" in numbers and numbers["fig6"]["designs"]:
         d = next(iter(numbers["fig6"]["designs"].values()))
