@@ -8,7 +8,6 @@ from dataclasses import fields
 from typing import Any
 
 import numpy as np
-from scipy import special
 
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
@@ -73,6 +72,8 @@ def anchor_group(h: np.ndarray, mask: np.ndarray) -> np.ndarray:
 
 def truncated_normal_ppf(u: np.ndarray, mean: float, sd: float, high: float) -> np.ndarray:
     """Inverse CDF of a normal(mean, sd) truncated to [0, high], at u in [0, 1)."""
+    from scipy import special  # where it is used: a few tenths of a second to import
+
     lo, hi = special.ndtr((0.0 - mean) / sd), special.ndtr((high - mean) / sd)
     return mean + sd * special.ndtri(lo + u * (hi - lo))
 

@@ -25,7 +25,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.stats import qmc
 
 from metainterface.data._draws import (
     anchor_group,
@@ -74,6 +73,10 @@ def sample_lhs(
     [0, h_max Delta_max]: along every one of the 2N axes each of the ``count`` equal strata
     holds exactly one point. Returns (gamma, h), both (count, N).
     """
+    # imported here: scipy.stats costs ~1 s to import, and ``train`` reads this module
+    # without drawing
+    from scipy.stats import qmc
+
     n = settings.n_asperities
     try:
         lhs = qmc.LatinHypercube(d=2 * n, scramble=params.scramble, rng=rng)
