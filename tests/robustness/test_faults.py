@@ -111,8 +111,8 @@ def test_generate_killed_or_interrupted(tmp_path):
 
 
 def _train_killed(dataset: Path, run: Path, rng: random.Random) -> None:
-    common = ["train", "--dataset", str(dataset), "--out", str(run), "--epochs", "30"]
-    common += ["--batch-size", "32", "--patience", "30"]
+    common = ["train", "--dataset", str(dataset), "--out", str(run), "--epochs", "12"]
+    common += ["--batch-size", "32", "--patience", "12"]
     proc = start(*common)
     assert wait_until(lambda: metrics_rows(run) >= 2 or proc.poll() is not None)
     time.sleep(rng.uniform(0.0, 0.5))
@@ -131,7 +131,7 @@ def _train_killed(dataset: Path, run: Path, rng: random.Random) -> None:
         timeout=120,
     )
     assert resumed.returncode == 0, resumed.stderr
-    assert metrics_rows(run) == 30
+    assert metrics_rows(run) == 12
     assert not temporaries(run)
 
 
