@@ -106,8 +106,9 @@ def _generate_killed(tmp_path: Path, sig: int, delay: float) -> None:
 
 def test_generate_killed_or_interrupted(tmp_path):
     rng = random.Random(21)
-    _generate_killed(tmp_path / "kill", signal.SIGKILL, rng.uniform(3.0, 6.0))
-    _generate_killed(tmp_path / "int", signal.SIGINT, rng.uniform(3.0, 6.0))
+    # past the imports (about 1.5 s), inside the generation of 400,000 cells (tens of s)
+    _generate_killed(tmp_path / "kill", signal.SIGKILL, rng.uniform(2.0, 4.0))
+    _generate_killed(tmp_path / "int", signal.SIGINT, rng.uniform(2.0, 4.0))
 
 
 def _train_killed(dataset: Path, run: Path, rng: random.Random) -> None:
