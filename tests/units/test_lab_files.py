@@ -117,6 +117,8 @@ BAD_FRICTION = {
         "mN",
     ),
     "normal_force [blorps],friction_force\n1,0.3\n": ("unknown unit 'blorps'", "kN"),
+    # a force whose factor to newtons overflows (years^90): pint's OverflowError was a traceback
+    "normal_force [N (a/s)^90],friction_force\n1,0.3\n": ("floating-point range", "mN"),
     "normal_force,friction_force [kg]\n1,0.3\n": ("column friction_force [kg]", "not a force"),
     "normal_force,friction_coefficient [N]\n1,0.3\n2,0.3\n3,0.3\n": (
         "friction_coefficient",

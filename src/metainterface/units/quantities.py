@@ -89,18 +89,24 @@ def parse_quantity(
             raise MetainterfaceError(
                 f"{expect}; cannot read {text!r} as a quantity", argument=option
             ) from None
-        if not isinstance(quantity, ureg.Quantity):  # a plain number: SI
-            si = float(quantity)
-        elif quantity.dimensionless:
-            si = float(quantity.to("dimensionless").magnitude)
-        elif quantity.check(dims):
-            si = float(quantity.to(si_unit.replace("^", "**")).magnitude)
-        else:
+        try:
+            if not isinstance(quantity, ureg.Quantity):  # a plain number: SI
+                si = float(quantity)
+            elif quantity.dimensionless:
+                si = float(quantity.to("dimensionless").magnitude)
+            elif quantity.check(dims):
+                si = float(quantity.to(si_unit.replace("^", "**")).magnitude)
+            else:
+                raise MetainterfaceError(
+                    f"{expect}; {text!r} has dimension {quantity.dimensionality}, "
+                    f"not that of {article} {dimension}",
+                    argument=option,
+                )
+        # a unit to a huge power ('0a90': years^90) overflows pint's conversion factor
+        except (ArithmeticError, ValueError):
             raise MetainterfaceError(
-                f"{expect}; {text!r} has dimension {quantity.dimensionality}, "
-                f"not that of {article} {dimension}",
-                argument=option,
-            )
+                f"{expect}; {text!r} is out of the floating-point range", argument=option
+            ) from None
     if not math.isfinite(si):
         raise MetainterfaceError(f"{option} must be finite, got {value!r}", argument=option)
     if positive and si <= 0:
@@ -158,7 +164,13 @@ def force_unit(unit: str | None, *, where: str) -> float:
         raise MetainterfaceError(
             f"{where}: {text!r} is not a force unit; a force column takes {FORCE_UNITS}"
         )
-    return float(quantity.to("N").magnitude)
+    try:
+        return float(quantity.to("N").magnitude)
+    except (ArithmeticError, ValueError):  # e.g. N (a/s)^90: a factor past float range
+        raise MetainterfaceError(
+            f"{where}: {text!r} is out of the floating-point range; a force column takes "
+            f"{FORCE_UNITS}"
+        ) from None
 
 
 def parse_pressure_limit(
