@@ -254,7 +254,9 @@ def residuals(
     fn = model.sweep
     with torch.no_grad():
         gamma, h = param.to_design(raw, settings, sort=model.placed)
-        delta, p_max = solve_delta(gamma, h, settings, target.p, sweep_fn=fn)
+        delta, p_max = solve_delta(
+            gamma, h, settings, target.p, sweep_fn=fn, load_fn=model.newton_load
+        )
         weight = point_weights(p_max, target, undershoot).sqrt()  # (B, M)
     rep = raw.detach().repeat_interleave(m, 0).requires_grad_(True)
     g_rep, h_rep = param.to_design(rep, settings, sort=model.placed)

@@ -80,6 +80,36 @@ class Curve:
         )
 
 
+@dataclass(frozen=True)
+class ModelCurve:
+    """A model's response to one design along a dense Delta sweep (float64 numpy).
+
+    p_star: (K,) non-decreasing P* = P / E*, ending at the load reached at Delta_max.
+    alpha: (K,) contact-area fraction. asperity_alpha: (K, N) each asperity's contact
+    area / A_nom (sums to alpha), or None if the model does not resolve it.
+    """
+
+    p_star: np.ndarray
+    alpha: np.ndarray
+    asperity_alpha: np.ndarray | None = None
+
+    @property
+    def p_star_max(self) -> float:
+        """P* at Delta_max: the largest load the design reaches."""
+        return float(self.p_star[-1])
+
+    def at(self, p_star: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """alpha (Q,) and asperity alpha (Q, N) (or None) at the loads ``p_star`` (Q,)."""
+        xq = torch.as_tensor(np.asarray(p_star, dtype=np.float64))[None]
+        xp = torch.as_tensor(self.p_star)[None]
+        alpha = interp(xq, xp, torch.as_tensor(self.alpha)[None])[0].numpy()
+        if self.asperity_alpha is None:
+            return alpha, None
+        per = torch.as_tensor(self.asperity_alpha).T  # (N, K): one row per asperity
+        cols = interp(xq.expand(per.shape[0], -1), xp.expand(per.shape[0], -1), per)
+        return alpha, cols.T.numpy()
+
+
 def features_from_normalised(
     alpha_hat: Tensor, stiffness_hat: Tensor, p_star_max: Tensor, alpha_max: Tensor
 ) -> Tensor:

@@ -17,6 +17,7 @@ instances; ``register_model`` adds one, and it is then accepted by ``design``, `
 
 from __future__ import annotations
 
+import functools
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, fields, is_dataclass, replace
 
@@ -29,7 +30,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.physics import adhesion as jkr
 from metainterface.physics import curves, pressures
 from metainterface.physics.cell import CellSettings, Design
-from metainterface.physics.curves import Curve, Sweep, anchor, delta_grid, to_grid
+from metainterface.physics.curves import Curve, ModelCurve, Sweep, anchor, delta_grid, to_grid
 from metainterface.physics.interaction import (
     CURVATURE,
     ITERATIONS,
@@ -44,36 +45,6 @@ from metainterface.physics.sneddon import area
 
 #: Delta samples of the dense sweep that BEM loads are interpolated on (:meth:`model_curve`).
 N_DELTA_DENSE = 8193
-
-
-@dataclass(frozen=True)
-class ModelCurve:
-    """A model's response to one design along a dense Delta sweep (float64 numpy).
-
-    p_star: (K,) non-decreasing P* = P / E*, ending at the load reached at Delta_max.
-    alpha: (K,) contact-area fraction. asperity_alpha: (K, N) each asperity's contact
-    area / A_nom (sums to alpha), or None if the model does not resolve it.
-    """
-
-    p_star: np.ndarray
-    alpha: np.ndarray
-    asperity_alpha: np.ndarray | None = None
-
-    @property
-    def p_star_max(self) -> float:
-        """P* at Delta_max: the largest load the design reaches."""
-        return float(self.p_star[-1])
-
-    def at(self, p_star: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """alpha (Q,) and asperity alpha (Q, N) (or None) at the loads ``p_star`` (Q,)."""
-        xq = torch.as_tensor(np.asarray(p_star, dtype=np.float64))[None]
-        xp = torch.as_tensor(self.p_star)[None]
-        alpha = interp(xq, xp, torch.as_tensor(self.alpha)[None])[0].numpy()
-        if self.asperity_alpha is None:
-            return alpha, None
-        per = torch.as_tensor(self.asperity_alpha).T  # (N, K): one row per asperity
-        cols = interp(xq.expand(per.shape[0], -1), xp.expand(per.shape[0], -1), per)
-        return alpha, cols.T.numpy()
 
 
 class ForwardModel(ABC):
@@ -267,9 +238,13 @@ class ForwardModel(ABC):
         last value beyond P*_max. Interpolated in an ``n_delta`` sweep, or, with ``exact``
         (exact law only), solved for P*(Delta) = p_star by Newton with exact gradients."""
         fn = self.sweep if exact else self.load_area
-        return pressures.alpha_at(
-            gamma, h, settings, p_star, smooth=smooth, n_delta=n_delta, sweep_fn=fn, exact=exact
-        )
+        opts = {"smooth": smooth, "n_delta": n_delta, "exact": exact, "load_fn": self.newton_load}
+        return pressures.alpha_at(gamma, h, settings, p_star, sweep_fn=fn, **opts)
+
+    def newton_load(self, gamma: Tensor, h: Tensor, settings: CellSettings):
+        """``load(delta=...)``: P* and ``load_slope`` of (B, N) designs at Deltas (B, M), for
+        the Newton steps of ``pressures.solve_delta``; the sweep unless a model has less."""
+        return functools.partial(self.sweep, gamma, h, settings)
 
     def alpha_at_loads(
         self,
@@ -335,6 +310,12 @@ class Independent(ForwardModel):
         if self.adhesion:
             return self._adhesive_sweep(gamma, h, settings, n_delta=n_delta, delta=delta)[0]
         return curves.sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta)
+
+    def newton_load(self, gamma, h, settings):
+        # without adhesion: P* and its slope alone, ~12 operations a step against ~35
+        if self.adhesion:
+            return super().newton_load(gamma, h, settings)
+        return pressures.independent_load(gamma, h, settings)
 
     def asperity_sweep(self, gamma, h, settings, *, n_delta=None, delta=None):
         if self.adhesion:

@@ -32,6 +32,7 @@ def alpha_at(
     n_delta: int | None = None,
     sweep_fn: Callable[..., Sweep] | None = None,
     exact: bool = False,
+    load_fn: LoadFactory | None = None,
 ) -> tuple[Tensor, Tensor]:
     """alpha of (B, N) designs at given pressures p_star (B, M), and P*_max (B,).
 
@@ -40,12 +41,15 @@ def alpha_at(
     forward model (default: the independent one, :func:`sweep`). By default alpha is
     interpolated linearly in a sweep of ``n_delta`` samples (settings.n_steps); ``exact``
     solves P*(Delta) = p_star instead (:func:`at_pressures`, exact law only; ``sweep_fn``
-    must give ``load_slope`` and S*) and is exact to round-off, with exact gradients.
+    must give ``load_slope`` and S*) and is exact to round-off, with exact gradients;
+    ``load_fn`` gives its Newton steps a cheaper load (see :func:`solve_delta`).
     """
     if exact:
         if smooth is not None:
             raise ValueError("exact alpha_at is for the exact contact law (smooth=None)")
-        sw, p_max = at_pressures(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
+        sw, p_max = at_pressures(
+            gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn, load_fn=load_fn
+        )
         return sw.alpha, p_max
     sw = (sweep_fn or sweep)(gamma, h, settings, smooth=smooth, n_delta=n_delta)
     zero = torch.zeros_like(sw.p_star[:, :1])
@@ -53,7 +57,13 @@ def alpha_at(
     return interp(p_star, p, torch.cat([zero, sw.alpha], dim=-1)), p[:, -1]
 
 
-def _independent_load(gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
+#: ``load_fn(gamma, h, settings)`` -> ``load(delta=...)``: P* and dP*/dDelta (``load_slope``)
+#: of (B, N) designs at per-design Deltas (B, M), for the Newton steps of :func:`solve_delta`
+#: (a forward model's ``newton_load``).
+LoadFactory = Callable[[Tensor, Tensor, CellSettings], Callable[..., Sweep]]
+
+
+def independent_load(gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
     """``load(delta=...)``: P* and dP*/dDelta of the independent model of (B, N) designs at
     per-design Deltas (B, M), nothing else.
 
@@ -89,6 +99,7 @@ def at_pressures(
     *,
     n_delta: int | None = None,
     sweep_fn: Callable[..., Sweep] | None = None,
+    load_fn: LoadFactory | None = None,
 ) -> tuple[Sweep, Tensor]:
     """The exact-law response of (B, N) designs where P*(Delta) equals p_star (B, M), and
     P*_max (B,) (detached); Delta = Delta_max where p_star >= P*_max.
@@ -99,7 +110,9 @@ def at_pressures(
     ``sweep_fn`` (default :func:`sweep`) must accept a (B, M) ``delta`` and give
     ``load_slope``.
     """
-    delta, p_max = solve_delta(gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn)
+    delta, p_max = solve_delta(
+        gamma, h, settings, p_star, n_delta=n_delta, sweep_fn=sweep_fn, load_fn=load_fn
+    )
     return at_delta(gamma, h, settings, p_star, delta, p_max, sweep_fn=sweep_fn), p_max
 
 
@@ -111,18 +124,22 @@ def solve_delta(
     *,
     n_delta: int | None = None,
     sweep_fn: Callable[..., Sweep] | None = None,
+    load_fn: LoadFactory | None = None,
 ) -> tuple[Tensor, Tensor]:
     """Delta (B, M) where P*(Delta) = p_star (B, M) for (B, N) designs, Delta_max where
     p_star >= P*_max; and P*_max (B,). No gradients.
 
     Newton steps from the linear interpolation of an ``n_delta``-sample sweep, kept inside
-    the sweep's bracket of the root (P* grows with Delta). For the default ``sweep_fn``
-    the steps evaluate only P* and its slope (:func:`_independent_load`).
+    the sweep's bracket of the root (P* grows with Delta). The steps evaluate ``load_fn``'s
+    load (a forward model's ``newton_load``), else, for the default ``sweep_fn``, only P* and
+    its slope (:func:`independent_load`), else the whole sweep.
     """
     fn = sweep_fn or sweep
     with torch.no_grad():
-        if fn is sweep:
-            newton_fn = _independent_load(gamma, h, settings)
+        if load_fn is not None:
+            newton_fn = load_fn(gamma, h, settings)
+        elif fn is sweep:
+            newton_fn = independent_load(gamma, h, settings)
         else:
             newton_fn = functools.partial(fn, gamma, h, settings)
         grid = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
