@@ -181,3 +181,22 @@ def test_interp_holds_ends_and_duplicate_knots():
 def test_settings_validation(kwargs, field):
     with pytest.raises(MetainterfaceError, match=field):
         CellSettings(**kwargs)
+
+
+def test_exact_alpha_at_given_loads_and_its_newton_load_match_hertz():
+    # the exact law at given pressures solves P*(Delta) = p by Newton steps on the model's
+    # newton_load (P* and dP*/dDelta alone for the independent model): both against Hertz,
+    # P* = 9 (4/3) d^1.5 / A, dP*/dDelta = 9 (2 sqrt(d)) / A, alpha = 9 pi d / A
+    from metainterface.physics.models import Independent
+
+    g = torch.full((1, 9), 2.0, dtype=F64)
+    h = torch.zeros(1, 9, dtype=F64)
+    model = Independent()
+    d = torch.linspace(1e-4, S.delta_max, 7, dtype=F64)[None]
+    load = model.newton_load(g, h, S)(delta=d)
+    np.testing.assert_allclose(load.p_star, 12 * d**1.5 / S.nominal_area, rtol=1e-12)
+    np.testing.assert_allclose(load.load_slope, 18 * d.sqrt() / S.nominal_area, rtol=1e-12)
+    p = 12 * d**1.5 / S.nominal_area
+    alpha, p_max = model.alpha_at(g, h, S, p, exact=True)
+    np.testing.assert_allclose(alpha, 9 * math.pi * d / S.nominal_area, rtol=1e-9)
+    assert float(p_max[0]) == pytest.approx(12 * S.delta_max**1.5 / S.nominal_area, rel=1e-12)

@@ -8,7 +8,8 @@ A forward model maps (B, N) designs to their response along a Delta sweep. Two s
 Both take ``adhesion=w`` (work of adhesion in units of E* R): JKR asperities, the loading
 curve under a rising force, and an unloading branch and pull-off force (``physics.adhesion``).
 
-Each implements ``sweep`` and ``asperity_sweep`` (and may give a cheaper ``load_area``);
+Each implements ``sweep`` and ``asperity_sweep`` (and may give a cheaper ``load_area``, and
+a cheaper ``newton_load`` for the exact law's Newton steps on Delta);
 everything else (curves, alpha at given pressures, the dense curve that BEM results are
 compared with) is derived once, in :class:`ForwardModel`. ``MODELS`` maps names to
 instances; ``register_model`` adds one, and it is then accepted by ``design``, ``curve``,
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import functools
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass, fields, is_dataclass, replace
 
 import numpy as np
@@ -241,7 +243,7 @@ class ForwardModel(ABC):
         opts = {"smooth": smooth, "n_delta": n_delta, "exact": exact, "load_fn": self.newton_load}
         return pressures.alpha_at(gamma, h, settings, p_star, sweep_fn=fn, **opts)
 
-    def newton_load(self, gamma: Tensor, h: Tensor, settings: CellSettings):
+    def newton_load(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
         """``load(delta=...)``: P* and ``load_slope`` of (B, N) designs at Deltas (B, M), for
         the Newton steps of ``pressures.solve_delta``; the sweep unless a model has less."""
         return functools.partial(self.sweep, gamma, h, settings)
