@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from metainterface._threads import threads_for
 from metainterface.inverse.params import DTYPE, FULL
 from metainterface.inverse.starts import random_starts
 from metainterface.inverse.targets import Target
@@ -133,7 +134,9 @@ def compute_envelope(
         # one w per modulus: float32 takes 2.2x less and moves lo, hi and P*_reach by < 1e-6
         # relative (w = 1e-7 .. 3e-2, 4 and 9 asperities), against a 5 % tolerance.
         gamma, h = gamma.float(), h.float()
-    with torch.no_grad():
+    # 2,024 cells at once: large kernels, which gain from every thread (1.85x on two idle
+    # cores, an adhesive one), unlike the design work that usually asks for the envelope
+    with torch.no_grad(), threads_for("heavy"):
         sw = Independent(adhesion=adhesion).load_area(gamma, h, settings)
         p, a = sw.p_star, sw.alpha
         if not adhesion:  # the adhesionless curve starts at the origin
