@@ -23,6 +23,7 @@ from metainterface.units.reach import alpha_bounds
 # PDMS on glass: w = 50 mJ/m^2, E* = 2.4 MPa, R = 0.5 mm; tau 0.3 MPa over 4 cm^2
 E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
 W = W_J / (E * R)
+UNITS = dict(shear_strength="0.3MPa", modulus="2.4MPa", radius="0.5mm")
 
 
 def _held_back_law(seed=11, rows=24):
@@ -38,6 +39,24 @@ def _write(tmp_path, fn, ff):
         + "".join(f"{x:.12g},{y:.12g}\n" for x, y in zip(fn, ff, strict=True))
     )
     return path
+
+
+@pytest.mark.parametrize("fit", ["auto", "always"])
+def test_a_fit_does_not_pin_an_adhesive_offset_to_zero_unasked(tmp_path, fit):
+    """Without w, a fit pins F_f(0) at 0: a law whose zero-load friction is a real share of
+    it is refused, naming the row and the option, not designed as another law; a sensor's
+    offset (below 5 % of the largest friction) is fitted away as before."""
+    fn, ff = _held_back_law()
+    path = _write(tmp_path, fn, ff)
+    opts = dict(shear_strength=TAU, e_star=E, radius=R, area=AREA, fit=fit)
+    with pytest.raises(MetainterfaceError, match=r"row 1: friction .* zero normal force \(1"):
+        friction_target(path, **opts)
+    with pytest.raises(MetainterfaceError, match="--work-of-adhesion"):  # its fit is "auto"
+        mi.reachability(path, area="4cm2", **UNITS)
+    assert friction_target(path, work_of_adhesion=W_J, **opts).law.friction_force[0] > 0
+    small = ff - ff[0] + 0.02 * ff[-1]  # an offset of 2 % of the largest friction
+    ft = friction_target(_write(tmp_path, fn, small), **opts)
+    assert ft.law.friction_force[0] == 0.0
 
 
 def test_units():

@@ -38,6 +38,7 @@ from metainterface.units.law_file import (
     check_law,
     check_values,
     read_friction_csv,
+    zero_load_friction,
 )
 
 #: Points a target needs (the design command's minimum), the added origin included.
@@ -51,6 +52,10 @@ FIT_CHOICES = FIT_NAMES
 #: contact curve follows (fewer rows are too few to fit a curve to; they are kept).
 FIT_BELOW_ROWS = 10
 FIT_MIN_ROWS = 5
+#: Without adhesion a fit pins the friction at zero load to 0; rows with more than this share
+#: of their largest friction there are refused instead (the reach test's tolerance: less is
+#: within the curve error's scale, e.g. a sensor's offset).
+ZERO_LOAD_SHARE = 0.05
 
 
 def friction_to_alpha(
@@ -191,6 +196,8 @@ def prepare_law(
                 return law, None
     check_values(law.source, "normal_force", law.normal_force)
     check_values(law.source, "friction_force", law.friction_force)
+    if not offset:
+        _no_adhesive_offset(law)
     loads = np.unique(law.normal_force[law.normal_force > 0])
     if loads.size < MIN_POINTS:
         raise MetainterfaceError(
@@ -203,6 +210,20 @@ def prepare_law(
         normal_force=fn, friction_force=ff, rows=np.arange(fn.size), source=law.source
     )
     return fitted, lf
+
+
+def _no_adhesive_offset(law: FrictionLaw) -> None:
+    """Refuse rows whose friction at zero load is above ZERO_LOAD_SHARE of the largest: a
+    fit without adhesion pins F_f(0) at 0, and would design another law than the one
+    measured there without a word. A smaller one (a sensor's offset) is fitted away."""
+    at_zero = np.flatnonzero(law.normal_force == 0)
+    if not at_zero.size:
+        return
+    k = int(at_zero[np.argmax(law.friction_force[at_zero])])
+    top = float(np.max(law.friction_force))
+    if law.friction_force[k] > ZERO_LOAD_SHARE * top:
+        share = f" ({100 * law.friction_force[k] / top:.3g} % of the largest)"
+        raise MetainterfaceError(zero_load_friction(law, k, share))
 
 
 def friction_target(

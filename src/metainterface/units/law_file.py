@@ -104,6 +104,15 @@ def check_values(source: Any, name: str, values: np.ndarray) -> None:
             raise MetainterfaceError(f"{source}: row {i}: {name} = {v:g}; must be finite and >= 0")
 
 
+def zero_load_friction(law: FrictionLaw, k: int, why: str = "") -> str:
+    """The one-line error for row ``k``'s friction at zero normal force without adhesion."""
+    return (
+        f"{law.source}: row {law.rows[k]}: friction {law.friction_force[k]:g} N at zero "
+        f"normal force{why}; with F_f = tau A_real (no adhesion) friction vanishes with the "
+        f"load (give --work-of-adhesion for an adhesive contact)"
+    )
+
+
 def check_law(law: FrictionLaw, *, offset: bool = False) -> None:
     """Raise MetainterfaceError, naming the row, if the curve is impossible with tau > 0;
     ``offset`` (adhesion): friction at zero load is allowed."""
@@ -114,11 +123,7 @@ def check_law(law: FrictionLaw, *, offset: bool = False) -> None:
     check_values(src, "friction_force", ff)
     for k in range(fn.size):
         if fn[k] == 0 and ff[k] > 0 and not offset:
-            raise MetainterfaceError(
-                f"{src}: row {rows[k]}: friction {ff[k]:g} N at zero normal force; with "
-                f"F_f = tau A_real (no adhesion) friction vanishes with the load (give "
-                f"--work-of-adhesion for an adhesive contact)"
-            )
+            raise MetainterfaceError(zero_load_friction(law, k))
         if k == 0:
             continue
         if fn[k] <= fn[k - 1]:
