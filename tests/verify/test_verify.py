@@ -232,7 +232,10 @@ def test_cli_exits_3_above_max_bem_error(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "BEM" in text.splitlines()[0]
     assert "is above --max-bem-error 0.001 %" in text
-    assert json.loads((out / "design.json").read_text())["bem_check"]["ok"] is False
+    block = json.loads((out / "design.json").read_text())["bem_check"]
+    assert block["ok"] is False
+    # beside it, the model's own error at the same loads: the design's miss or the mechanics
+    assert f"the model's error at the same loads: {100 * block['model_error']:.3g} %" in text
 
 
 def test_cli_no_verify_and_bad_options(tmp_path, capsys):
