@@ -148,6 +148,10 @@ def test_offset_law_designed_within_two_percent(tmp_path):
     # checked in the adhesive BEM (a coarse grid here: a / dx ~ 5-10, see bench_adhesion)
     assert result.bem is not None and result.bem.adhesion == pytest.approx(W)
     assert result.bem.p_star.size >= 2 and np.isfinite(result.bem.bem_error)
+    # the offset F_0, one point of the curve error, is stated on its own: the law's is the
+    # CSV's zero-load row
+    (zero,) = [n for n in result.notes if "friction at zero load" in n]
+    assert f"the law's {ff[0]:.3g} N" in zero
 
 
 def test_friction_law_designs_say_what_adhesion_would_change(tmp_path):

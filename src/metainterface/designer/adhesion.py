@@ -101,11 +101,12 @@ def adhesion_notes(
     s = design.settings
     if model.adhesion:
         p_off = model.design_pull_off(design)
-        return (
+        notes = (
             f"adhesion: pull-off force {p_off * e_star * area:.3g} N over the interface "
             f"(P*_off = {p_off:.3g}, w = {friction.get('work_of_adhesion_j_m2', 0) * 1e3:.3g} "
             "mJ/m^2)",
         )
+        return notes + _offset_note(result, gamma, h, tau * area)
     w = work_of_adhesion / (e_star * radius)
     if not 0 < w <= ADHESION_LIMIT or not model.takes_adhesion:
         return ()
@@ -129,4 +130,29 @@ def adhesion_notes(
         f"glass) this design's friction would be {100 * change[1]:+.3g} % at {fn[1]:.3g} N, "
         f"{100 * change[0]:+.3g} % at {fn[0]:.3g} N and {zero * tau * area:.3g} N at zero "
         "load; design with --work-of-adhesion if the part's interface adheres",
+    )
+
+
+def _offset_note(result: Any, gamma: Any, h: Any, scale: float) -> tuple[str, ...]:
+    """The design's friction at zero load against the law's F_f(0) [N] (``scale`` = tau A):
+    an offset law's F_0, which the curve error, over the whole load range, weighs as one
+    point of many."""
+    import numpy as np
+    import torch
+
+    t = result.target
+    if not (t.p_star.size and t.p_star[0] == 0 and t.alpha[0] > 0):
+        return ()
+    tiny = torch.tensor([[1e-12 * float(t.p_star_max)]], dtype=torch.float64)
+    try:
+        with torch.no_grad():
+            zero = result.model.alpha_at_loads(gamma, h, result.design.settings, tiny)
+    except MetainterfaceError:
+        return ()
+    f_design, f_law = float(zero[0, 0]) * scale, float(t.alpha[0]) * scale
+    if not np.isfinite(f_design):
+        return ()
+    return (
+        f"adhesion: friction at zero load {f_design:.3g} N, the law's {f_law:.3g} N "
+        f"({100 * (f_design / f_law - 1):+.3g} %)",
     )
