@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
+from metainterface._names import MODEL_NAMES
 from metainterface.cli.common import add_device, positive_float, positive_int
 
 
@@ -26,9 +26,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--physics",
         choices=MODEL_NAMES,
-        default=DEFAULT_MODEL,
-        help="forward model: the paper's independent asperities (default) or with their "
-        "elastic interaction through the periodic lattice",
+        default=None,
+        help="forward model: the paper's independent asperities or with their elastic "
+        "interaction through the periodic lattice (default: the design file's own model, "
+        "its adhesion included; the independent one for a file without)",
     )
     p.add_argument("--out", required=True, help="output CSV")
     p.add_argument("--plot", help="also draw alpha(P*) and S*(P*) to this PNG/PDF")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from metainterface._names import DEFAULT_MODEL, MODEL_NAMES
+from metainterface._names import MODEL_NAMES
 from metainterface.cli.common import add_device
 
 #: How the library's errors name the options: as typed on the command line.
@@ -61,8 +61,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--model",
         choices=MODEL_NAMES,
-        default=DEFAULT_MODEL,
-        help="forward model (default: the paper's independent asperities)",
+        default=None,
+        help="forward model (default: the design file's own model, its adhesion included; "
+        "the paper's independent asperities for a file without)",
     )
     p.add_argument(
         "--target",

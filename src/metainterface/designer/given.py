@@ -18,6 +18,7 @@ from metainterface._threads import uses_threads
 from metainterface.designer.curve_result import CURVE_STEPS, Curve, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings, Design
+from metainterface.physics.labels import design_model
 from metainterface.physics.limits import PressureCheck, check_pressure
 from metainterface.physics.models import ForwardModel
 from metainterface.units.dimensions import physical_block
@@ -136,7 +137,8 @@ def curve(
     settings : CellSettings
         The cell of ``gamma`` and ``h`` (default: the paper's).
     model : str or ForwardModel
-        The forward model (default ``"independent"``).
+        The forward model (default: the one a design file recorded, adhesion included,
+        else ``"independent"``).
     steps : int
         Delta samples, in [2, 1000000].
     smooth : float
@@ -154,7 +156,7 @@ def curve(
     if smooth is not None:
         smooth = _checks.number("smooth", smooth, low=SMOOTH_RANGE[0], high=SMOOTH_RANGE[1])
     dev = resolve_device(device, small=True)
-    return design_curve(d, model, steps=steps, smooth=smooth, device=dev)
+    return design_curve(d, design_model(d, model), steps=steps, smooth=smooth, device=dev)
 
 
 @uses_threads()

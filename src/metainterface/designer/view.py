@@ -14,7 +14,7 @@ from metainterface.designer.curve_result import design_curve
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
-from metainterface.physics.models import MODELS, get_model
+from metainterface.physics.models import get_model
 
 #: Files up to this size are embedded in the page (data: URIs); larger ones are linked.
 EMBED_BYTES = 8_000_000
@@ -173,8 +173,13 @@ def _stress(pa: float) -> str:
 
 
 def _model_of(record: dict[str, Any]):
+    """The model the design file recorded (adhesion included), else the default; a label
+    this session cannot read (a model registered elsewhere) draws with the default."""
     label = record.get("model")
-    return get_model(label if isinstance(label, str) and label in MODELS else None)
+    try:
+        return get_model(label if isinstance(label, str) else None)
+    except MetainterfaceError:
+        return get_model(None)
 
 
 def _target(source: Any, record: dict[str, Any]):

@@ -34,7 +34,7 @@ import torch
 from torch import Tensor
 
 from metainterface.inverse.params import DTYPE
-from metainterface.inverse.perturb import Perturbation, loaded
+from metainterface.inverse.perturb import REACH, Perturbation, loaded
 from metainterface.inverse.refine import TargetGrid, relative_error
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.metrics import curve_error
@@ -126,6 +126,10 @@ def spread(
     m = grid.shape[0]
     p_all = torch.cat([grid, ref.p[0]])[None]
     g_s, h_s = pert.apply(g0, h0)
+    # an adhesive curve's snap-ins are placed by its sweep's samples: the loaded range's
+    # fall on the design's own ones and go on at their spacing (at the same count, a copy
+    # identical to the design read up to 0.01 of alpha off it beside a snap-in)
+    n_delta = round(REACH * (own_settings.n_steps - 1)) + 1 if model.adhesion else None
     with torch.no_grad():
         alpha, reach = model.alpha_at(
             torch.cat([g0, g_s]),
@@ -133,6 +137,7 @@ def spread(
             settings,
             p_all.expand(g_s.shape[0] + 1, -1),
             exact=True,
+            n_delta=n_delta,
         )
     band, at_ref = alpha[:, :m], alpha[:, m:]
     errors = curve_error(at_ref, ref.alpha.expand_as(at_ref), ref.p.expand_as(at_ref), reach)

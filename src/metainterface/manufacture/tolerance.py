@@ -28,7 +28,8 @@ from metainterface.inverse import scatter as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.labels import design_model
+from metainterface.physics.models import ForwardModel
 from metainterface.units.plausible import warn_unit_slips
 from metainterface.units.printer import length_in_r
 from metainterface.units.quantities import parse_pressure, parse_quantity
@@ -261,7 +262,7 @@ def _prepare(design, model, samples, seed, target, radius, option_names):
     d = as_design(design, None, None, None)
     samples = _checks.whole(option_names["samples"], samples, low=MIN_SAMPLES, high=MAX_SAMPLES)
     seed = _checks.whole(option_names["seed"], seed, low=0, high=2**63 - 1)
-    fm = get_model(model)
+    fm = design_model(d, model)  # a design file's own model (its adhesion) by default
     ref = _reference(d, target)
     r_m = _radius(radius, d, option_names["radius"])
     return d, fm, samples, seed, ref, r_m
@@ -321,7 +322,8 @@ def tolerance(
     seed : int
         Seed of the draws; the same seed gives the same samples and files.
     model : str or ForwardModel
-        The forward model (default ``"independent"``).
+        The forward model (default: the one a design file recorded, adhesion included,
+        else ``"independent"``).
     radius : str or float
         Asperity radius R ('0.5mm', or metres); default the design file's physical block.
     scale_sigma : float

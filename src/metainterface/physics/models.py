@@ -42,6 +42,7 @@ from metainterface.physics.interaction import (
     sweep_interacting,
 )
 from metainterface.physics.jkr import check_adhesion
+from metainterface.physics.labels import from_label
 from metainterface.physics.metrics import interp
 from metainterface.physics.sneddon import area
 
@@ -241,7 +242,16 @@ class ForwardModel(ABC):
         (exact law only), solved for P*(Delta) = p_star by Newton with exact gradients."""
         fn = self.sweep if exact else self.load_area
         opts = {"smooth": smooth, "n_delta": n_delta, "exact": exact, "load_fn": self.newton_load}
-        return pressures.alpha_at(gamma, h, settings, p_star, sweep_fn=fn, **opts)
+        if not self.adhesion:
+            return pressures.alpha_at(gamma, h, settings, p_star, sweep_fn=fn, **opts)
+        # an adhesive curve is a path (the force's running maximum along the Deltas given):
+        # the loads go in ascending, whatever order they come in (a tolerance study asks
+        # for two grids in one call; unsorted, the second read the first's maximum)
+        order = torch.argsort(p_star, dim=-1)
+        alpha, p_max = pressures.alpha_at(
+            gamma, h, settings, p_star.gather(-1, order), sweep_fn=fn, **opts
+        )
+        return alpha.gather(-1, torch.argsort(order, dim=-1)), p_max
 
     def newton_load(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
         """``load(delta=...)``: P* and ``load_slope`` of (B, N) designs at Deltas (B, M), for
@@ -408,15 +418,20 @@ def register_model(model: ForwardModel) -> ForwardModel:
 
 
 def get_model(model: str | ForwardModel | None = None) -> ForwardModel:
-    """The model for a name or an instance (None: the default, ``independent``)."""
+    """The model for a name, a label as files record it (``independent(adhesion=4e-05)``,
+    :attr:`ForwardModel.label`) or an instance (None: the default, ``independent``)."""
     if model is None:
         return MODELS[DEFAULT_MODEL]
     if isinstance(model, ForwardModel):
         return model
     if isinstance(model, str) and model in MODELS:
         return MODELS[model]
+    found = from_label(model, MODELS) if isinstance(model, str) else None
+    if found is not None:
+        return found
     raise MetainterfaceError(
-        f"model must be one of {', '.join(MODELS)} or a ForwardModel, got {model!r}"
+        f"model must be one of {', '.join(MODELS)} (or a label such as "
+        f"'independent(adhesion=4e-05)') or a ForwardModel, got {model!r}"
     )
 
 

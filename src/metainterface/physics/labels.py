@@ -1,0 +1,59 @@
+"""Forward models named by their labels, as output files record them.
+
+A model's label is its registered name and the options that differ from their defaults
+(``ForwardModel.label``): ``independent``, ``interacting(curvature=True)``,
+``independent(adhesion=4.1666666667e-05)``. Reading one back gives the model a design was
+made with, adhesion included, for the commands that take a design file.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from collections.abc import Mapping
+from dataclasses import fields, is_dataclass, replace
+from typing import Any
+
+from metainterface.physics.cell import Design
+from metainterface.physics.jkr import check_adhesion
+
+
+def from_label(label: str, registry: Mapping[str, Any]) -> Any | None:
+    """The model of ``registry`` with the options ``label`` names, or None where it names
+    no registered model, an option it lacks or a value that is not a literal."""
+    match = re.fullmatch(r"\s*(\w+)\((.*)\)\s*", label)
+    if match is None or match[1] not in registry or not is_dataclass(registry[match[1]]):
+        return None
+    base = registry[match[1]]
+    names = {f.name for f in fields(base)}
+    opts: dict[str, Any] = {}
+    for item in filter(None, (part.strip() for part in match[2].split(","))):
+        key, _, text = item.partition("=")
+        try:
+            value = ast.literal_eval(text.strip())
+        except (ValueError, SyntaxError):
+            return None
+        if key.strip() not in names or not isinstance(value, bool | int | float | str):
+            return None
+        opts[key.strip()] = value
+    try:
+        model = replace(base, **opts)
+    except (TypeError, ValueError):
+        return None
+    if getattr(model, "adhesion", 0.0):
+        check_adhesion(model.adhesion)  # a file's value out of range: one line, named
+    return model
+
+
+def design_model(design: Design, model: str | Any | None = None) -> Any:
+    """The model to evaluate ``design`` with: ``model`` if given, else the one its file
+    recorded (design.json's "model": an adhesive design keeps its adhesion), else the
+    default."""
+    from metainterface.physics.models import get_model  # the registry imports this module
+
+    if model is not None:
+        return get_model(model)
+    label = design.extras.get("model")
+    if isinstance(label, str):
+        return get_model(label)
+    return get_model(None)
