@@ -18,9 +18,8 @@ from metainterface._threads import uses_threads
 from metainterface.designer.curve_result import CURVE_STEPS, Curve, design_curve, idle_notes
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings, Design
-from metainterface.physics.labels import design_model
 from metainterface.physics.limits import PressureCheck, check_pressure
-from metainterface.physics.models import ForwardModel
+from metainterface.physics.models import ForwardModel, get_model
 from metainterface.units.dimensions import physical_block
 from metainterface.units.plausible import warn_unit_slips
 from metainterface.units.quantities import (
@@ -315,3 +314,15 @@ def pressure_check(
         return check_pressure(d, limit)
     e_star = parse_pressure(modulus, option="modulus")
     return check_pressure(d, limit * e_star, e_star=e_star)
+
+
+def design_model(design: Design, model: str | ForwardModel | None = None) -> ForwardModel:
+    """The model to evaluate ``design`` with: ``model`` if given, else the one its file
+    recorded (design.json's "model": an adhesive design keeps its adhesion), else the
+    default."""
+    if model is not None:
+        return get_model(model)
+    label = design.extras.get("model")
+    if isinstance(label, str):
+        return get_model(label)
+    return get_model(None)

@@ -22,13 +22,13 @@ from metainterface._device import resolve_device
 from metainterface._files import provenance, strict_json, write_columns, write_text
 from metainterface._threads import uses_threads
 from metainterface.designer.curve_result import ReachCounts, shown
+from metainterface.designer.given import design_model
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse import scatter as tol
 from metainterface.inverse.perturb import GAMMA_FLOOR, Perturbation
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
-from metainterface.physics.labels import design_model
 from metainterface.physics.models import ForwardModel
 from metainterface.units.plausible import warn_unit_slips
 from metainterface.units.printer import length_in_r

@@ -14,7 +14,6 @@ from collections.abc import Mapping
 from dataclasses import fields, is_dataclass, replace
 from typing import Any
 
-from metainterface.physics.cell import Design
 from metainterface.physics.jkr import check_adhesion
 
 
@@ -43,17 +42,3 @@ def from_label(label: str, registry: Mapping[str, Any]) -> Any | None:
     if getattr(model, "adhesion", 0.0):
         check_adhesion(model.adhesion)  # a file's value out of range: one line, named
     return model
-
-
-def design_model(design: Design, model: str | Any | None = None) -> Any:
-    """The model to evaluate ``design`` with: ``model`` if given, else the one its file
-    recorded (design.json's "model": an adhesive design keeps its adhesion), else the
-    default."""
-    from metainterface.physics.models import get_model  # the registry imports this module
-
-    if model is not None:
-        return get_model(model)
-    label = design.extras.get("model")
-    if isinstance(label, str):
-        return get_model(label)
-    return get_model(None)
