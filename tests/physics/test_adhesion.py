@@ -154,6 +154,19 @@ def test_cell_of_one_sphere():
     assert float(mi.Independent().pull_off(gamma, h, s)[0]) == 0.0
 
 
+def test_exact_alpha_at_zero_load_is_the_state_the_force_holds():
+    """alpha at P* = 0 (a friction law's zero-load row, as designs and errors read it): the
+    JKR sphere at zero load, a^3 = 9/2 pi w R^2, not a state inside the snap-in plateau."""
+    s = CellSettings(n_asperities=1)
+    gamma, h = t([[2.0]]), t([[0.0]])
+    p = t([[0.0, 1e-5, 2e-5]])
+    alpha, _ = mi.Independent(adhesion=W).alpha_at(gamma, h, s, p, exact=True)
+    a0 = (4.5 * math.pi * W) ** (1 / 3)
+    # (the plateau's inside read 1.3 % low here, and 28 % low on a 9-asperity design where
+    # more asperities snap in within it; the branch's first state is within 5e-4)
+    assert float(alpha[0, 0]) == pytest.approx(math.pi * a0**2 / s.nominal_area, rel=1e-3)
+
+
 def _reference_load_control(heights, w, loads):
     """Contact radii of spheres under load control, by brute force (scipy, no torch).
 

@@ -248,9 +248,11 @@ class ForwardModel(ABC):
         # the loads go in ascending, whatever order they come in (a tolerance study asks
         # for two grids in one call; unsorted, the second read the first's maximum)
         order = torch.argsort(p_star, dim=-1)
-        alpha, p_max = pressures.alpha_at(
-            gamma, h, settings, p_star.gather(-1, order), sweep_fn=fn, **opts
-        )
+        ascending = p_star.gather(-1, order)
+        # zero load is where the force, rising from zero, first holds: the end of the
+        # plateau at P* = 0 (its inside is every state the snap-in passes through)
+        ascending = torch.maximum(ascending, 1e-12 * ascending[..., -1:])
+        alpha, p_max = pressures.alpha_at(gamma, h, settings, ascending, sweep_fn=fn, **opts)
         return alpha.gather(-1, torch.argsort(order, dim=-1)), p_max
 
     def newton_load(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
