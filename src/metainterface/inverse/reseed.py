@@ -110,10 +110,12 @@ def reseed(
         r = results[i]
         if e <= max(r.error * (1 + RESEED_SLACK), r.error + RESEED_FLOOR):
             row = j * k + b
+            n_idle = int(idle[i].sum())
             note = (
-                f"target {r.target.name}: {_count(int(idle[i].sum()))} that never touched "
-                f"over the target's range were re-seeded, {_count(int(left[j, b]))} idle "
-                f"now (error {100 * r.error:.3g} % -> {100 * e:.3g} %)"
+                f"target {r.target.name}: {_count(n_idle)} that never touched over the "
+                f"target's range {'was' if n_idle == 1 else 'were'} re-seeded, "
+                f"{_count(int(left[j, b]))} idle now (error {100 * r.error:.3g} % -> "
+                f"{100 * e:.3g} %)"
             )
             out[i] = replace(
                 r,
