@@ -11,6 +11,7 @@ import numpy as np
 from metainterface._files import strict_json
 from metainterface._files.atomic import write_text
 from metainterface.designer.curve_result import design_curve
+from metainterface.designer.given import design_model
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
@@ -86,7 +87,7 @@ def _collect(source: Any, path: str | os.PathLike[str] | None) -> dict[str, Any]
     elif isinstance(source, Design):
         design, name = source, "design"
         record = dict(source.extras)
-        model = _model_of(record)
+        model = _model_of(design)
     elif isinstance(source, str | os.PathLike):
         file = Path(source)
         if file.is_dir():
@@ -97,7 +98,7 @@ def _collect(source: Any, path: str | os.PathLike[str] | None) -> dict[str, Any]
         design = Design.load(file)
         record = dict(design.extras)
         name = str(record.get("target", {}).get("name") or file.parent.name or file.stem)
-        model = _model_of(record)
+        model = _model_of(design)
     else:
         raise MetainterfaceError(
             "view: source must be a DesignResult, a Design or a design folder/file path, "
@@ -172,12 +173,11 @@ def _stress(pa: float) -> str:
     return f"{pa:.4g} Pa"
 
 
-def _model_of(record: dict[str, Any]):
+def _model_of(design: Design):
     """The model the design file recorded (adhesion included), else the default; a label
     this session cannot read (a model registered elsewhere) draws with the default."""
-    label = record.get("model")
     try:
-        return get_model(label if isinstance(label, str) else None)
+        return design_model(design)
     except MetainterfaceError:
         return get_model(None)
 

@@ -14,12 +14,11 @@ from collections.abc import Mapping
 from dataclasses import fields, is_dataclass, replace
 from typing import Any
 
-from metainterface.physics.jkr import check_adhesion
-
 
 def from_label(label: str, registry: Mapping[str, Any]) -> Any | None:
     """The model of ``registry`` with the options ``label`` names, or None where it names
-    no registered model, an option it lacks or a value that is not a literal."""
+    no registered model, an option it lacks or a value that is not a literal; a value the
+    model refuses raises its MetainterfaceError."""
     match = re.fullmatch(r"\s*(\w+)\((.*)\)\s*", label)
     if match is None or match[1] not in registry or not is_dataclass(registry[match[1]]):
         return None
@@ -35,10 +34,5 @@ def from_label(label: str, registry: Mapping[str, Any]) -> Any | None:
         if key.strip() not in names or not isinstance(value, bool | int | float | str):
             return None
         opts[key.strip()] = value
-    try:
-        model = replace(base, **opts)
-    except (TypeError, ValueError):
-        return None
-    if getattr(model, "adhesion", 0.0):
-        check_adhesion(model.adhesion)  # a file's value out of range: one line, named
-    return model
+    # the model checks its own options: a value out of range is its one-line error
+    return replace(base, **opts)
