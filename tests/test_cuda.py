@@ -185,3 +185,60 @@ def test_adhesive_training_loss_on_cuda_matches_cpu():
         out[dev] = (err.detach().cpu(), gd.grad.cpu())
     assert torch.allclose(out["cpu"][0], out["cuda"][0], rtol=1e-9, atol=1e-12)
     assert torch.allclose(out["cpu"][1], out["cuda"][1], rtol=1e-6, atol=1e-9)
+
+
+def test_bem_check_on_cuda_matches_cpu(tmp_path):
+    """The torch BEM engine solves the same contacts on CUDA as on the CPU: one design, and
+    a batch of designs solved together (``validate_many(batch=...)``, a GPU's default)."""
+    designs = [
+        r.design
+        for r in mi.design(
+            ["saturating", "bilinear"],
+            verify=False,
+            device="cpu",
+            effort=mi.Effort(refine_settings=QUICK),
+        )
+    ]
+    a = mi.validate(designs[0], grid=96, loads=4, device="cpu")
+    b = mi.validate(designs[0], grid=96, loads=4, device="cuda")
+    np.testing.assert_allclose(b.p_star, a.p_star, rtol=1e-12)
+    np.testing.assert_allclose(b.alpha_bem, a.alpha_bem, rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(b.p_max, a.p_max, rtol=1e-5)
+    out = mi.validate_many(
+        designs, tmp_path / "many", grid=96, loads=4, device="cuda", batch=2, progress=False
+    )
+    assert len(out) == 2 and not any("error" in s for s in out.values())
+    first = out[sorted(out)[0]]
+    assert first["max_rel_err"] == pytest.approx(a.max_rel_err, rel=1e-4, abs=1e-9)
+
+
+def test_adhesive_bem_check_on_cuda_matches_cpu():
+    """An adhesive design's check (the JKR-limit BEM under a rising force) reads the same
+    contact on CUDA as on the CPU, to a point of the grid (the detachment criterion is a
+    comparison on the mesh, which rounding may tip at one boundary point)."""
+    from metainterface.physics import CellSettings
+
+    s, w = CellSettings(), 0.05 / (2.4e6 * 0.5e-3)  # PDMS on glass at R = 0.5 mm
+    rng = np.random.default_rng(3)
+    g, h = rng.uniform(1.8, 4.0, 9), rng.uniform(0, 0.6, 9) * s.delta_max
+    model = mi.Independent(adhesion=w)
+    with torch.no_grad():
+        gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h - h.min())[None]
+        top = 0.9 * float(model.sweep(gt, ht, s).p_star[0, -1])
+        p = np.linspace(1e-12 * top, top, 16)
+        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
+    target = mi.Target(p_star=p, alpha=a, name="sticky")
+    checks = {
+        dev: mi.design(
+            target,
+            model=model,
+            verify=mi.Verify(grid=48, loads=4, correct=False, device=dev),
+            effort=mi.Effort(refine=False, seed=0),
+        ).bem
+        for dev in ("cpu", "cuda")
+    }
+    cpu, gpu = checks["cpu"], checks["cuda"]
+    assert gpu.device.startswith("cuda") and cpu.device == "cpu"
+    np.testing.assert_allclose(gpu.p_star, cpu.p_star, rtol=1e-6)
+    np.testing.assert_allclose(gpu.alpha_bem, cpu.alpha_bem, atol=2 / 48**2)
+    assert gpu.bem_error == pytest.approx(cpu.bem_error, abs=5e-3)
