@@ -126,7 +126,11 @@ def test_design_on_cuda_matches_cpu(method):
 def test_many_targets_on_cuda():
     builtins = [mi.Target.builtin(n) for n in ("saturating", "bilinear", "linear")] * 34
     targets = [replace(t, name=f"{t.name}-{i}") for i, t in enumerate(builtins)]
-    results = mi.design(targets, device="cuda", effort=mi.Effort(refine_settings=QUICK))
+    # the batched refinement on the GPU is what is tested; each design's BEM check (102
+    # checks and corrections, minutes) is left to the tests of the BEM on CUDA below
+    results = mi.design(
+        targets, device="cuda", verify=False, effort=mi.Effort(refine_settings=QUICK)
+    )
     assert len(results) == 102 and all(np.isfinite(r.error) for r in results)
 
 
