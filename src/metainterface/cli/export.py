@@ -17,7 +17,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(0.5mm, 500um); a plain number is in metres.",
     )
     p.add_argument("design", help="design file (metainterface/design-v1 JSON)")
-    p.add_argument("--radius", required=True, help="asperity radius R, e.g. 0.5mm")
+    p.add_argument(
+        "--radius",
+        help="asperity radius R, e.g. 0.5mm (default: the one design.json records, as a "
+        "friction law's or a sized design's does)",
+    )
     p.add_argument(
         "--tiles",
         default="1x1",
@@ -80,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
     rec = mi.export(
         args.design,
         args.out,
-        radius=parse_length(args.radius, option="--radius"),
+        radius=None if args.radius is None else parse_length(args.radius, option="--radius"),
         tiles=args.tiles,
         format=args.format,
         resolution=resolution,

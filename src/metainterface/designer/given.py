@@ -29,6 +29,7 @@ from metainterface.units.quantities import (
     parse_pressure,
     parse_pressure_limit,
 )
+from metainterface.units.recorded import recorded
 
 #: Most points of a curve (a sane run time).
 MAX_STEPS = 1_000_000
@@ -163,7 +164,7 @@ def export(
     design: Design | str | os.PathLike[str],
     path: str | os.PathLike[str],
     *,
-    radius: str | float,
+    radius: str | float | None = None,
     tiles: tuple[int, int] | str = (1, 1),
     format: str | None = None,
     resolution: float | None = None,
@@ -181,7 +182,8 @@ def export(
         Output file; its suffix picks the format unless ``format`` is given. A sidecar
         ``path.json`` records the height scale, grid and provenance.
     radius : str or float
-        Asperity radius R ('0.5mm', or metres).
+        Asperity radius R ('0.5mm', or metres); default: the one the design file records
+        (its physical block, or the friction law it was designed for).
     tiles : (nx, ny), 'NXxNY' or 'auto'
         Cells along x and y; 'auto': the tiling design.json's physical block gives for the
         area or total force designed for (a design.json path written with them, e.g. by
@@ -216,9 +218,23 @@ def export(
         tiles = _designed_tiles(design)
     if resolution is not None:
         resolution = _checks.number("resolution", resolution, low=0.0, low_open=True)
-    radius_m = parse_length(radius, option="radius")
+    made_for = recorded(d, "radius_m")
+    if radius is None and made_for is None:
+        raise MetainterfaceError(
+            "radius is needed: the design file records no asperity radius (no physical or "
+            "friction-law block); give one, e.g. '0.5mm'",
+            argument="radius",
+        )
+    radius_m = made_for if radius is None else parse_length(radius, option="radius")
     _physical("radius", radius_m)
     warn_unit_slips(radius=radius_m)
+    scale_note = ()
+    if made_for is not None and abs(radius_m / made_for - 1) > 1e-9:
+        scale_note = (
+            f"radius {radius_m * 1e3:.4g} mm is not the {made_for * 1e3:.4g} mm the design file "
+            "records: the part is scaled by R (its forces at a given pressure by R^2), so it "
+            "is not the part designed for",
+        )
     source = str(design) if isinstance(design, str | os.PathLike) else None
     step = None
     if z_step is not None:
@@ -228,7 +244,7 @@ def export(
     flank_step = _checks.whole("flank_step", flank_step, low=1, high=64)
     if not isinstance(force, bool):
         raise MetainterfaceError(f"force must be True or False, got {force!r}")
-    notes = (*idle_notes(d), *_cells_note(d, tiles))
+    notes = (*idle_notes(d), *_cells_note(d, tiles), *scale_note)
     record = export_design(
         d,
         path,

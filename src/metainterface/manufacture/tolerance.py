@@ -33,6 +33,7 @@ from metainterface.physics.models import ForwardModel
 from metainterface.units.plausible import warn_unit_slips
 from metainterface.units.printer import length_in_r
 from metainterface.units.quantities import parse_pressure, parse_quantity
+from metainterface.units.recorded import recorded
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -47,30 +48,13 @@ def _radius(radius: Any, design: Design, option: str) -> float | None:
     """R [m] from the argument, else from the design file's physical or friction record."""
     if radius is not None:
         return parse_quantity(radius, "length", option=option)
-    phys = design.extras.get("physical")
-    if isinstance(phys, dict) and isinstance(phys.get("radius_m"), int | float):
-        return float(phys["radius_m"])
-    fric = _friction_record(design)
-    if isinstance(fric.get("radius_m"), int | float):
-        return float(fric["radius_m"])
-    return None
-
-
-def _friction_record(design: Design) -> dict:
-    target = design.extras.get("target")
-    fric = target.get("friction") if isinstance(target, dict) else None
-    return fric if isinstance(fric, dict) else {}
+    return recorded(design, "radius_m")
 
 
 def _stress(value: Any, design: Design, keys: tuple[str, ...], option: str) -> float | None:
     if value is not None:
         return parse_pressure(value, option=option)
-    for block in (design.extras.get("physical"), _friction_record(design)):
-        if isinstance(block, dict):
-            for key in keys:
-                if isinstance(block.get(key), int | float):
-                    return float(block[key])
-    return None
+    return recorded(design, *keys)
 
 
 def _reference(design: Design, target: Target | str | None) -> Target | None:
