@@ -121,3 +121,15 @@ def test_validate_physics_reports_both(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "by model (loads from the interacting model): independent" in printed
     assert '"loads_from": "interacting"' in (out / "models.csv").read_text().splitlines()[0]
+
+
+def test_validate_of_an_adhesive_design_says_it_leaves_adhesion_out(tmp_path, capsys):
+    design = json.loads(Path(EXAMPLE).read_text())
+    design["model"] = "independent(adhesion=4e-05)"  # as design.json records it
+    path = tmp_path / "d.json"
+    path.write_text(json.dumps(design))
+    args = ["validate", str(path), "--grid", "48", "--loads", "2", "--workers", "1"]
+    assert main([*args, "--out", str(tmp_path / "run")]) == 0
+    err = capsys.readouterr().err
+    assert "designed with the adhesive model independent(adhesion=4e-05)" in err
+    assert "without adhesion, against the independent model" in err

@@ -23,3 +23,17 @@ def test_interacting_model_curve():
     both = models_at(design, curve.p_star[[2000, 8192]])
     np.testing.assert_allclose(both["interacting"], curve.alpha[[2000, 8192]], rtol=1e-4)
     assert both["independent"][-1] != both["interacting"][-1]
+
+
+@pytest.mark.parametrize("call", ["validate", "validate_many"])
+def test_an_adhesive_model_is_refused_not_compared_with_a_bem_without_adhesion(tmp_path, call):
+    """This BEM leaves adhesion out: against an adhesive model every load would read
+    adhesion's own effect (tens of per cent at low load) as the model's error."""
+    import metainterface as mi
+
+    model = mi.Independent(adhesion=4e-5)
+    with pytest.raises(mi.MetainterfaceError, match="has adhesion, which this BEM leaves out"):
+        if call == "validate":
+            mi.validate(EXAMPLE, grid=48, loads=2, model=model)
+        else:
+            mi.validate_many([EXAMPLE], tmp_path / "many", grid=48, loads=2, model=model)

@@ -180,17 +180,27 @@ class _ReaderMayLeave:
 
 @contextlib.contextmanager
 def _unit_slips_in_one_line(args: argparse.Namespace) -> Iterator[None]:
-    """Show each unit-slip warning (``--modulus 2.4`` read as 2.4 Pa) and each reach warning
-    (a target partly out of reach) once, as one line on stderr: ``metainterface design:
+    """Show each unit-slip warning (``--modulus 2.4`` read as 2.4 Pa), each reach warning
+    (a target partly out of reach) and any other caution the package raises once, as one
+    line on stderr: ``metainterface design:
     warning: modulus 2.4 Pa is below 1 kPa: ...``. The same value is checked on every path
     that reads it (the law, its feasible scale, the design)."""
     from metainterface.cli.common import SHOWN
     from metainterface.errors import ReachWarning, UnitSlipWarning
 
     default = warnings.showwarning
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
+
+    def ours(category: type, filename: Any) -> bool:
+        # the package's own cautions (the user's inputs, its results), not a library's
+        if issubclass(category, UnitSlipWarning | ReachWarning):
+            return True
+        return issubclass(category, UserWarning) and os.path.abspath(str(filename)).startswith(
+            package
+        )
 
     def show(message: Any, category: type, *rest: Any, **kw: Any) -> None:
-        if not issubclass(category, UnitSlipWarning | ReachWarning):
+        if not ours(category, rest[0] if rest else kw.get("filename", "")):
             default(message, category, *rest, **kw)
         elif str(message) not in SHOWN:
             SHOWN.add(str(message))

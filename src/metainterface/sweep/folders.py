@@ -20,6 +20,7 @@ import contextlib
 import hashlib
 import json
 import os
+import warnings
 from collections.abc import Sequence
 from concurrent.futures import Executor
 from pathlib import Path
@@ -138,6 +139,14 @@ def validate(
             raise MetainterfaceError("design must be a Design or a design file path")
         design = Design.load(design)
     fm = get_model(model)
+    made_with = design.extras.get("model")
+    if isinstance(made_with, str) and _adhesive(made_with):
+        warnings.warn(
+            f"{name} was designed with the adhesive model {made_with}; validate solves its "
+            f"contact without adhesion, against the {fm.label} model (design's check is "
+            "the adhesive one)",
+            stacklevel=2,
+        )
     if p_max is not None:
         k = _checks.whole("loads", loads, low=1, high=10_000)
         p_max = _checks.number("p_max", p_max, low=0.0, low_open=True)
@@ -180,6 +189,14 @@ def validate(
             write_result(result, out, command="validate", jobs=jobs)
             write_models(result, Path(out) / "models.csv")
     return result
+
+
+def _adhesive(label: str) -> bool:
+    """Whether a design file's model label names a model with adhesion."""
+    try:
+        return bool(get_model(label).adhesion)
+    except MetainterfaceError:  # a model of another session's registry: not ours to judge
+        return False
 
 
 def write_models(result: ValidationResult, path: Path) -> dict[str, np.ndarray]:

@@ -302,6 +302,16 @@ def plan_validation(
     grid = default_grid(design.settings) if grid is None else check_grid(grid, design.settings)
     design_target(design)  # a malformed target fails now, not after the solve
     model = get_model(model)
+    if model.adhesion:
+        # this BEM has no adhesion: against an adhesive model every load would read the
+        # adhesion's own effect (tens of per cent at low load) as the model's error
+        raise MetainterfaceError(
+            f"model {model.label} has adhesion, which this BEM leaves out: an adhesive "
+            "design is checked in the adhesive (JKR-limit) BEM by design's check "
+            "(mi.design(..., verify=mi.Verify()), or the design command); here compare "
+            "the adhesionless model, e.g. model='independent'",
+            argument="model",
+        )
     p_top = model.model_curve(design).p_star_max
     return ValidationPlan(
         name=name,
