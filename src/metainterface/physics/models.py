@@ -245,13 +245,15 @@ class ForwardModel(ABC):
         if not self.adhesion:
             return pressures.alpha_at(gamma, h, settings, p_star, sweep_fn=fn, **opts)
         # an adhesive curve is a path (the force's running maximum along the Deltas given):
-        # the loads go in ascending, whatever order they come in (a tolerance study asks
-        # for two grids in one call; unsorted, the second read the first's maximum)
+        # loads go in ascending (a tolerance study asks for two grids in one call)
         order = torch.argsort(p_star, dim=-1)
         ascending = p_star.gather(-1, order)
-        # zero load is where the force, rising from zero, first holds: the end of the
-        # plateau at P* = 0 (its inside is every state the snap-in passes through)
-        ascending = torch.maximum(ascending, 1e-12 * ascending[..., -1:])
+        # zero load: where the rising force first holds, the end of the plateau at P* = 0
+        # (not a state the snap-in passes), at 1e-12 of the top load asked, else of P*_max
+        top = ascending[..., -1:]
+        if bool((top <= 0).any()):
+            top = torch.where(top > 0, top, self.load_area(gamma, h, settings).p_star[:, -1:])
+        ascending = torch.maximum(ascending, 1e-12 * top)
         alpha, p_max = pressures.alpha_at(gamma, h, settings, ascending, sweep_fn=fn, **opts)
         return alpha.gather(-1, torch.argsort(order, dim=-1)), p_max
 

@@ -162,8 +162,17 @@ def solve_delta(
             if bool(done.all()):
                 break
             slope = sw.load_slope
-            move = torch.where(~done & (slope > 0), resid / torch.where(slope > 0, slope, 1.0), 0.0)
-            delta = torch.minimum(torch.maximum(delta - move, lo), hi)
+            newton = ~done & (slope > 0)
+            move = torch.where(newton, resid / torch.where(slope > 0, slope, 1.0), 0.0)
+            # a point short of its load where the curve is flat (an adhesive cell inside a
+            # snap-in, where the force has not yet regained its running maximum) has no
+            # Newton step: it moves up, halfway to the top of its bracket, which the sweep's
+            # knots put past the root
+            stuck = ~done & ~newton & (resid < 0)
+            lo = torch.where(stuck, delta, lo)
+            delta = torch.where(
+                stuck, 0.5 * (delta + hi), torch.minimum(torch.maximum(delta - move, lo), hi)
+            )
     return delta, p_max
 
 
