@@ -85,7 +85,8 @@ class Verify:
     restart : bool
         Each correction iteration also designs afresh against the shifted target (the
         surrogate and its hedge starts, on the correction's model) and keeps whichever
-        design meets it better in that model (default True; no extra BEM solve). Not for
+        design meets it better in that model (default True; no extra BEM solve); the first
+        skips it where the re-refined design meets the shifted target within 0.1 %. Not for
         the Hertz baseline or heights fixed on a printer's layers.
     max_error : float
         The BEM error a design is trusted within (0.02 = 2 %), in (0, 1]; above it the result

@@ -28,7 +28,11 @@ shifted target by a few tenths of a per cent in the model; the BEM error cannot 
 that. With ``Verify.restart`` (default) each iteration also designs afresh against the
 shifted target (the surrogate's prediction and its hedge starts, refined on the
 correction's model) and keeps whichever of the two meets the shifted target better in that
-model: no extra BEM solve.
+model: no extra BEM solve. The fresh design costs several re-refinements (nine starts on
+the interacting model), so the first iteration makes it only where the re-refined design
+misses the shifted target by more than ``FRESH_GATE`` (within it the candidate already
+meets its target about as closely as the correction resolves, ``STOP_ERROR``); once the BEM
+has said that one iteration was not enough, every later one makes it too.
 """
 
 from __future__ import annotations
@@ -52,6 +56,9 @@ from metainterface.verify.check import BemCheck, Verify, bem_check
 #: The correction stops once the BEM error is this low (0.1 %): about the BEM's own accuracy
 #: at the default grid, below which a further step corrects the grid, not the design.
 STOP_ERROR = 1e-3
+#: The first iteration makes a fresh design only where the re-refined one misses the shifted
+#: target by more than this (relative curve error in the correction's model).
+FRESH_GATE = STOP_ERROR
 #: Hedge starts of a fresh design (the CLI's default ``--hedge``).
 RESTART_HEDGE = 8
 
@@ -242,10 +249,11 @@ def correct(
         candidate = re_refine(best, curve, inner, param, extra_loss, refine_settings)
         start = "current"
         if settings.restart and param is FULL:
-            fresh = fresh_design(curve, best.settings, inner, extra_loss, refine_settings, i)
-            if fresh is not None and curve_fit_error(fresh, curve, inner) < curve_fit_error(
-                candidate, curve, inner
-            ):
+            fit = curve_fit_error(candidate, curve, inner)
+            fresh = None
+            if fit > FRESH_GATE or done:
+                fresh = fresh_design(curve, best.settings, inner, extra_loss, refine_settings, i)
+            if fresh is not None and curve_fit_error(fresh, curve, inner) < fit:
                 candidate, start = fresh, "fresh"
         cand_check = bem_check(candidate, target, settings, fm)
         accepted = cand_check.bem_error < best_check.bem_error
