@@ -70,6 +70,16 @@ def temporaries(folder: Path) -> list[Path]:
     return [p for p in folder.rglob("*") if ".mi-" in p.name]
 
 
+def catches(pid: int, sig: int) -> bool:
+    """Whether process ``pid`` has a handler installed for ``sig`` (its SigCgt in /proc)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    caught = next(line for line in status.splitlines() if line.startswith("SigCgt:"))
+    return bool(int(caught.split()[1], 16) >> (sig - 1) & 1)
+
+
 def metrics_rows(run: Path) -> int:
     try:
         with open(run / "metrics.csv", encoding="utf-8") as fh:
@@ -85,9 +95,13 @@ def dataset(tmp_path_factory) -> Path:
     return path
 
 
-def _generate_killed(tmp_path: Path, sig: int, delay: float) -> None:
+def _generate_killed(tmp_path: Path, sig: int, delay: float, writing: bool = False) -> None:
+    """Signal a generation ``delay`` s after its start, or with ``writing`` that long after
+    its temporary file appeared (the generation under way, whatever the machine's speed)."""
     out = tmp_path / "g" / "data.npz"
     proc = start("generate", "--samples", "400000", "--seed", "0", "--out", str(out), "--quiet")
+    if writing:
+        assert wait_until(lambda: temporaries(tmp_path) or proc.poll() is not None)
     time.sleep(delay)
     proc.send_signal(sig)
     rc = proc.wait(60)
@@ -106,9 +120,11 @@ def _generate_killed(tmp_path: Path, sig: int, delay: float) -> None:
 
 def test_generate_killed_or_interrupted(tmp_path):
     rng = random.Random(21)
-    # past the imports (about 1.5 s), inside the generation of 400,000 cells (tens of s)
-    _generate_killed(tmp_path / "kill", signal.SIGKILL, rng.uniform(2.0, 4.0))
-    _generate_killed(tmp_path / "int", signal.SIGINT, rng.uniform(2.0, 4.0))
+    # inside the generation of 400,000 cells (tens of s): up to 1 s after its temporary file
+    # appeared (about 1.5 s from the start, past the imports), rather than 2-4 s from the
+    # start, most of which was a wait for the imports
+    _generate_killed(tmp_path / "kill", signal.SIGKILL, rng.uniform(0.0, 1.0), writing=True)
+    _generate_killed(tmp_path / "int", signal.SIGINT, rng.uniform(0.0, 1.0), writing=True)
 
 
 def _train_killed(dataset: Path, run: Path, rng: random.Random) -> None:
@@ -181,7 +197,12 @@ def _alive(pid: int) -> bool:
 def test_design_interrupted_writes_all_or_nothing(tmp_path, sig):
     out = tmp_path / "d"
     proc = start("design", "--target", "bilinear", "--out", str(out), "--no-verify")
-    time.sleep(random.Random(int(sig)).uniform(2.0, 6.0))
+    # once the command turns SIGTERM into an interrupt (its run under way: before it the
+    # signal kills with the default action, not the command's), then a moment in the next
+    # 1.5 s: the run's imports, design and writing take about 1.7 s here. A fixed 2-6 s from
+    # the start fell after the end of the run: only the finished run's files were checked.
+    assert wait_until(lambda: catches(proc.pid, signal.SIGTERM) or proc.poll() is not None)
+    time.sleep(random.Random(int(sig)).uniform(0.0, 1.5))
     proc.send_signal(sig)
     rc = proc.wait(120)
     names = sorted(p.name for p in out.iterdir()) if out.exists() else []
