@@ -159,7 +159,7 @@ def test_an_unreachable_scheduler_is_one_line(tmp_path, capsys):
     d.with_name("b.json").write_text(d.read_text())
     mi_args = [*args, "--scheduler", "tcp://127.0.0.1:9", "--out", str(out)]
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr("metainterface.validation.cluster.CONNECT_TIMEOUT", 2)
+        mp.setattr("metainterface.validation.cluster.CONNECT_TIMEOUT", 0.5)
         assert main(mi_args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in err[0]
