@@ -125,7 +125,8 @@ class Effort:
     hedge_error : float
         Surrogate method: the hedge starts are refined (after the prediction's own design)
         only for targets that design misses by more than this relative curve error
-        (default 1e-4: a design within it gains nothing that matters from more starts);
+        (default 5e-4, half the BEM's accuracy: a design within it gains nothing that
+        matters from more starts);
         0 refines them with the prediction in one batch, for every target.
 
     Examples
