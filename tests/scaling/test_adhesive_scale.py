@@ -137,6 +137,10 @@ def test_design_scale_designs_an_offset_law_with_its_area(law_csv):
     assert any(lo <= sc["value"] <= hi for lo, hi in sc["feasibility"]["ranges"]["area"])
     assert r.error < 0.05
     assert mi.reachability(r.target).reachable
+    # quick scores that tie are settled by full designs: the chosen one is the best of them
+    finalists, scores = sc["finalists"], sc["finalist_scores"]
+    assert len(finalists) == 2 and sc["value"] in finalists
+    assert r.error == pytest.approx(min(scores), rel=1e-9)
 
 
 def test_design_cli_area_auto_with_work_of_adhesion(law_csv, tmp_path, capsys):
