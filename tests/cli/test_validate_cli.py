@@ -133,3 +133,15 @@ def test_validate_of_an_adhesive_design_says_it_leaves_adhesion_out(tmp_path, ca
     err = capsys.readouterr().err
     assert "designed with the adhesive model independent(adhesion=4e-05)" in err
     assert "without adhesion, against the independent model" in err
+
+
+def test_a_sweep_with_an_adhesive_design_says_it_leaves_adhesion_out(tmp_path, capsys):
+    design = json.loads(Path(EXAMPLE).read_text())
+    (tmp_path / "plain.json").write_text(json.dumps(design))
+    design["model"] = "independent(adhesion=4e-05)"
+    (tmp_path / "sticky.json").write_text(json.dumps(design))
+    args = ["validate", str(tmp_path / "plain.json"), str(tmp_path / "sticky.json")]
+    assert main([*args, "--grid", "48", "--loads", "2", "--out", str(tmp_path / "run")]) == 0
+    err = capsys.readouterr().err
+    assert "sticky was designed with the adhesive model independent(adhesion=4e-05)" in err
+    assert "plain" not in err.split("warning:")[-1]

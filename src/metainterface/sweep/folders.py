@@ -139,14 +139,7 @@ def validate(
             raise MetainterfaceError("design must be a Design or a design file path")
         design = Design.load(design)
     fm = get_model(model)
-    made_with = design.extras.get("model")
-    if isinstance(made_with, str) and _adhesive(made_with):
-        warnings.warn(
-            f"{name} was designed with the adhesive model {made_with}; validate solves its "
-            f"contact without adhesion, against the {fm.label} model (design's check is "
-            "the adhesive one)",
-            stacklevel=2,
-        )
+    warn_adhesive([(name, design)], fm)
     if p_max is not None:
         k = _checks.whole("loads", loads, low=1, high=10_000)
         p_max = _checks.number("p_max", p_max, low=0.0, low_open=True)
@@ -189,6 +182,27 @@ def validate(
             write_result(result, out, command="validate", jobs=jobs)
             write_models(result, Path(out) / "models.csv")
     return result
+
+
+def warn_adhesive(items: list[tuple[str, Design]], model: ForwardModel) -> None:
+    """Say once that the designs (name, Design) made with an adhesive model (design.json's
+    "model") are solved here without adhesion, against ``model``."""
+    if model.adhesion:  # refused by the plan, in its own words
+        return
+    made = [(n, d.extras.get("model")) for n, d in items]
+    sticky = [(n, m) for n, m in made if isinstance(m, str) and _adhesive(m)]
+    if not sticky:
+        return
+    what = (
+        f"{sticky[0][0]} was designed with the adhesive model {sticky[0][1]}"
+        if len(sticky) == 1
+        else f"{len(sticky)} designs were designed with adhesive models ({sticky[0][0]}, ...)"
+    )
+    warnings.warn(
+        f"{what}; validate solves the contact without adhesion, against the {model.label} "
+        "model (design's check is the adhesive one)",
+        stacklevel=3,
+    )
 
 
 def _adhesive(label: str) -> bool:

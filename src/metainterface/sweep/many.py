@@ -32,7 +32,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, require_xarray
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel, get_model
-from metainterface.sweep.folders import request_hash, write_result
+from metainterface.sweep.folders import request_hash, warn_adhesive, write_result
 from metainterface.validation.batched import solve_batched
 from metainterface.validation.bem import (
     MAX_ITER,
@@ -293,6 +293,7 @@ def validate_many(
             )
     out = Path(out_dir)
     items = _design_list(designs)
+    warn_adhesive(items, get_model(model))
     summaries: dict[str, dict[str, Any]] = {}
     todo: list[ValidationPlan] = []
     for name, design in items:
