@@ -28,12 +28,9 @@ CANDIDATES = 5
 QUICK = RefineSettings(
     stages=2, steps_per_stage=3, iterations=20, polish_iterations=20, reseed=False
 )
-#: With adhesion, candidates whose quick score is within this fraction of the best tie
-#: within the short refinement's noise (a snap-in moves a quick score by more than the
-#: scales differ): up to FINALISTS of them are designed in full (the model only, no BEM
-#: check) and the best full design's scale is chosen. Without adhesion the quick scores
-#: rank the scales as their full designs do (the same choice on the budget's law, in 2x
-#: the time), so the quick round decides.
+#: With adhesion (a snap-in moves a quick score more than the scales differ) the FINALISTS
+#: best quick scores within TIE of the best are designed in full, no BEM check, and the best
+#: kept; without it the quick round ranks as the full designs do (benchmarks/results/adhesion.md).
 TIE = 0.1
 FINALISTS = 2
 #: Options of the three scale variables, as the error messages name them.
@@ -417,11 +414,11 @@ def design_scale(
         at_size["work_of_adhesion"] = None
         if at_size["total_force"] is None:
             at_size["area"] = at["area"]
-        chosen_options = {**options, **extra}
-        chosen_options.update(as_groups(knobs, at_size, made_errors, options.get("robust", False)))
+        opts = {**options, **extra}
+        opts.update(as_groups(knobs, at_size, made_errors, options.get("robust", False)))
         with warnings.catch_warnings():  # a unit slip was said once, above
             warnings.simplefilter("ignore", UnitSlipWarning)
-            return design(t, settings=settings, **chosen_options)
+            return design(t, settings=settings, **opts)
 
     if len(tied) > 1 and given["work_of_adhesion"]:
         for i in tied:
