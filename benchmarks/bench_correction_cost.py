@@ -1,0 +1,47 @@
+"""What the BEM check and its correction cost on realisable targets (issue 36): ``mi.design``
+with its default check of N realisable targets (``bench_design.realisable_targets(N,
+seed=11)``), one after another; prints the CPU seconds of this process and its BEM workers
+and each target's BEM error. Compare two source trees by running it on each in turn
+(``PYTHONPATH=<tree>/src``), alternately.
+
+    PYTHONPATH=src python benchmarks/bench_correction_cost.py [--targets 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import metainterface as mi
+
+sys.path.insert(0, str(Path(__file__).parent))
+from bench_design import realisable_targets
+
+
+def cpu() -> float:
+    """CPU seconds of this process and its finished children (the BEM's workers)."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--targets", type=int, default=5)
+    args = ap.parse_args()
+    warnings.simplefilter("ignore")
+    mi.design("saturating")  # warm-up: the networks, the envelope, the BEM's workers
+    targets = realisable_targets(args.targets, seed=11)
+    c0, w0 = cpu(), time.perf_counter()
+    errors = [f"{100 * mi.design(t).bem.bem_error:.2f}" for t in targets]
+    print(
+        f"{mi.__file__}: CPU {cpu() - c0:.1f} s, wall {time.perf_counter() - w0:.1f} s; "
+        f"BEM errors %: {' '.join(errors)}"
+    )
+
+
+if __name__ == "__main__":
+    main()
