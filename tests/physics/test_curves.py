@@ -200,3 +200,26 @@ def test_exact_alpha_at_given_loads_and_its_newton_load_match_hertz():
     alpha, p_max = model.alpha_at(g, h, S, p, exact=True)
     np.testing.assert_allclose(alpha, 9 * math.pi * d / S.nominal_area, rtol=1e-9)
     assert float(p_max[0]) == pytest.approx(12 * S.delta_max**1.5 / S.nominal_area, rel=1e-12)
+
+
+@pytest.mark.parametrize("smooth", [None, 3e3])
+@pytest.mark.parametrize("per_design_delta", [False, True])
+def test_sweep_pullback_is_autograds_gradient(smooth, per_design_delta):
+    # heights not anchored, the lowest anywhere: the pullback anchors them as sweep does
+    from metainterface.physics.curves import sweep_pullback
+
+    s = CellSettings()
+    gen = torch.Generator().manual_seed(5)
+    gamma = (1.5 + 2.5 * torch.rand(3, 9, generator=gen, dtype=torch.float64)).requires_grad_()
+    h = (0.01 + 0.02 * torch.rand(3, 9, generator=gen, dtype=torch.float64)).requires_grad_()
+    delta = torch.linspace(0, s.delta_max, 40, dtype=torch.float64)
+    if per_design_delta:
+        delta = delta * torch.rand(3, 1, generator=gen, dtype=torch.float64)
+    g_p, g_a = torch.randn(2, 3, 40, generator=gen, dtype=torch.float64)
+    sw = sweep(gamma, h, s, smooth=smooth, delta=delta)
+    expected = torch.autograd.grad((sw.p_star * g_p + sw.alpha * g_a).sum(), (gamma, h))
+    closed, back = sweep_pullback(gamma.detach(), h.detach(), s, smooth=smooth, delta=delta)
+    torch.testing.assert_close(closed.p_star, sw.p_star.detach(), rtol=0, atol=0)
+    torch.testing.assert_close(closed.alpha, sw.alpha.detach(), rtol=0, atol=0)
+    for got, want in zip(back(g_p, g_a), expected, strict=True):
+        torch.testing.assert_close(got, want, rtol=1e-13, atol=0)

@@ -47,17 +47,24 @@ def _value_and_grad(fun: Callable[[Tensor], Tensor], x: Tensor) -> tuple[Tensor,
     return f.detach().nan_to_num(torch.inf, torch.inf, torch.inf), g.nan_to_num(0.0, 0.0, 0.0)
 
 
+def _given(fun: Callable[[Tensor], tuple[Tensor, Tensor]], x: Tensor) -> tuple[Tensor, Tensor]:
+    """:func:`_value_and_grad` for a ``fun`` that gives its gradient itself."""
+    f, g = fun(x)
+    return f.nan_to_num(torch.inf, torch.inf, torch.inf), g.nan_to_num(0.0, 0.0, 0.0)
+
+
 def _rows_value_and_grad(
-    fun: Callable[[Tensor, Tensor], Tensor], x: Tensor, idx: Tensor
+    fun: Callable[[Tensor, Tensor], Tensor], x: Tensor, idx: Tensor, gives_grad: bool = False
 ) -> tuple[Tensor, Tensor]:
     """Loss and gradient of the rows ``idx`` (R,) of x (B, D); inf and 0 elsewhere."""
+    both = _given if gives_grad else _value_and_grad
     # (shape[0], not len(): Tensor.__len__ is Python code, a few microseconds a call)
     if idx.shape[0] == x.shape[0]:  # all rows: nothing to gather or scatter
-        return _value_and_grad(lambda z: fun(z, idx), x)
+        return both(lambda z: fun(z, idx), x)
     f = x.new_full(x.shape[:1], torch.inf)
     g = torch.zeros_like(x)
     if idx.shape[0]:
-        f[idx], g[idx] = _value_and_grad(lambda z: fun(z, idx), x[idx])
+        f[idx], g[idx] = both(lambda z: fun(z, idx), x[idx])
     return f, g
 
 
@@ -160,6 +167,7 @@ def minimize(
     x0: Tensor,
     *,
     indexed: bool = False,
+    gives_grad: bool = False,
     lr: float = 0.5,
     max_iter: int = 100,
     history: int = 10,
@@ -176,6 +184,8 @@ def minimize(
     indexed: ``fun(x, idx)`` takes the rows ``idx`` (R,) of the batch, x (R, D), and returns
     their (R,) losses; the line search then evaluates only the rows still searching, so rows
     that have stopped cost nothing (with many starts, most stop long before the last).
+    gives_grad: ``fun`` returns (loss, gradient (B, D)) itself, a closed form, instead of a
+    loss that autograd differentiates.
 
     A row stops when its gradient is below ``tol_grad``, its loss below ``tol_loss``, an
     iteration changes its loss or its point by less than ``tol_change``, or (if ``tol_stall``
@@ -186,7 +196,9 @@ def minimize(
 
     def evaluate(x: Tensor, rows: Tensor) -> tuple[Tensor, Tensor]:
         """Loss and gradient at x; with ``indexed`` only the ``rows`` (R,) given."""
-        return _rows_value_and_grad(fun, x, rows) if indexed else _value_and_grad(fun, x)
+        if indexed:
+            return _rows_value_and_grad(fun, x, rows, gives_grad)
+        return _given(fun, x) if gives_grad else _value_and_grad(fun, x)
 
     def still(rows: Tensor) -> Tensor | None:
         """The rows (B,) that are True as an index (R,) (R x 1 unless ``indexed``), None if

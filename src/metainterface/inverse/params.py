@@ -8,6 +8,7 @@ optimises the heights only: the Hertz-only baseline is ``HERTZ`` (gamma = 2 ever
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import torch
@@ -18,6 +19,11 @@ from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 
 DTYPE = torch.float64
+
+# The derivatives of softplus (beta 1, threshold 20, nnf.softplus's defaults) and sigmoid,
+# given the upstream gradient: the kernels autograd itself runs for them.
+_softplus_back = torch.ops.aten.softplus_backward
+_sigmoid_back = torch.ops.aten.sigmoid_backward
 
 #: How far inside the bounds :meth:`Parameterisation.from_design` puts a start: gamma at
 #: least this fraction of its range from either bound, height gaps at least this fraction of
@@ -55,22 +61,39 @@ class Parameterisation:
 
         The losses skip the sort (``sort=False``) where the model does not place asperities
         (a sum over independent ones does not depend on their order)."""
-        n = settings.n_asperities
-        if self.fixed_gamma is not None:
-            r_h = raw
-            gamma = torch.full(
-                (raw.shape[0], n), float(self.fixed_gamma), dtype=raw.dtype, device=raw.device
-            )
-        else:
-            r_g, r_h = raw[:, :n], raw[:, n:]
-            span = settings.gamma_max - settings.gamma_min
-            gamma = settings.gamma_min + span * torch.sigmoid(r_g)
-        gaps = settings.delta_max * nnf.softplus(r_h)
-        h = torch.cat([torch.zeros_like(r_h[:, :1]), gaps], dim=-1)
+        gamma, h, _ = self.to_design_pullback(raw, settings)
         if not sort:
             return gamma, h
         h, order = torch.sort(h, dim=-1)
         return gamma.gather(-1, order), h
+
+    def to_design_pullback(
+        self, raw: Tensor, settings: CellSettings
+    ) -> tuple[Tensor, Tensor, Callable[[Tensor, Tensor], Tensor]]:
+        """(B, D) -> (gamma, h) (B, N) unsorted, and the pullback ``back(g_gamma, g_h)`` ->
+        the gradient (B, D) of ``raw`` for gradients (B, N) of gamma and h (the map's
+        derivatives by hand: a closed-form loss needs no autograd, ``physics.tape``)."""
+        n = settings.n_asperities
+        span = settings.gamma_max - settings.gamma_min
+        if self.fixed_gamma is not None:
+            u, r_h = None, raw
+            gamma = torch.full(
+                (raw.shape[0], n), float(self.fixed_gamma), dtype=raw.dtype, device=raw.device
+            )
+        else:
+            u, r_h = torch.sigmoid(raw[:, :n]), raw[:, n:]
+            gamma = settings.gamma_min + span * u
+        gaps = settings.delta_max * nnf.softplus(r_h)
+        h = torch.cat([torch.zeros_like(r_h[:, :1]), gaps], dim=-1)
+
+        def back(g_gamma: Tensor, g_h: Tensor) -> Tensor:
+            # autograd's own kernels, in its order: the gradient it would give, to the bit
+            g_r_h = _softplus_back(g_h[:, 1:] * settings.delta_max, r_h, 1.0, 20.0)
+            if u is None:
+                return g_r_h
+            return torch.cat([_sigmoid_back(g_gamma * span, u), g_r_h], dim=-1)
+
+        return gamma, h, back
 
     def from_design(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Tensor:
         """Inverse of :meth:`to_design` for (B, N) designs, ``START_MARGIN`` inside the
@@ -133,9 +156,17 @@ class FixedHeights(Parameterisation):
         return self.h if count == b else self.h.repeat_interleave(count // b, 0)
 
     def to_design(self, raw, settings, *, sort=True):
+        return self.to_design_pullback(raw, settings)[:2]
+
+    def to_design_pullback(self, raw, settings):
         span = settings.gamma_max - settings.gamma_min
-        gamma = settings.gamma_min + span * torch.sigmoid(raw)
-        return gamma, self._heights(raw.shape[0]).to(raw.dtype)
+        u = torch.sigmoid(raw)
+        gamma = settings.gamma_min + span * u
+
+        def back(g_gamma: Tensor, g_h: Tensor) -> Tensor:
+            return _sigmoid_back(g_gamma * span, u)
+
+        return gamma, self._heights(raw.shape[0]).to(raw.dtype), back
 
     def from_design(self, gamma, h, settings):
         u = ((gamma - settings.gamma_min) / (settings.gamma_max - settings.gamma_min)).clamp(

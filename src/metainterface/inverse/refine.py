@@ -29,7 +29,8 @@ from metainterface.inverse.perturb import Perturbation, loaded
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.metrics import curve_error, interp_weights
 from metainterface.physics.models import ForwardModel, get_model
-from metainterface.physics.pressures import at_delta, solve_delta
+from metainterface.physics.pressures import at_delta, at_delta_pullback, solve_delta
+from metainterface.physics.tape import pullback
 
 POLISH_METHODS = ("levmar", "lbfgs")
 
@@ -234,6 +235,44 @@ class InterpolatedLoss(torch.autograd.Function):
         return grad_x[:, 1:], grad_f[:, 1:], None, None, None
 
 
+def _stage_value_and_grad(
+    model: ForwardModel,
+    param: Parameterisation,
+    settings: CellSettings,
+    target: TargetGrid,
+    smooth: float | None,
+    undershoot: float,
+) -> Callable[[Tensor, Tensor], tuple[Tensor, Tensor]] | None:
+    """A stage's :func:`masked_loss` with its gradient in the unbounded parameters, the
+    chain of closed-form pullbacks applied by hand (``physics.tape``): ``fun(z, idx)`` ->
+    (loss (R,), gradient (R, D)) for the rows ``idx``. None where a step has no closed form
+    (a model without one, a placed model's sort): autograd then."""
+    sweep_fn = model.load_area_pullback(settings, smooth)
+    if sweep_fn is None or model.placed:
+        return None
+    needs = (True, True, False, False, False)
+
+    def fun(z: Tensor, idx: Tensor) -> tuple[Tensor, Tensor]:
+        rows = _rows(target, idx)
+        gamma, h, back_param = param.rows(idx).to_design_pullback(z, settings)
+        if smooth is None:  # the exact law: alpha at the target's pressures, as alpha_at
+            with torch.no_grad():
+                delta, p_max = solve_delta(
+                    gamma, h, settings, rows.p, sweep_fn=model.sweep, load_fn=model.newton_load
+                )
+            alpha, back = at_delta_pullback(sweep_fn, gamma, h, rows.p, delta, p_max)
+            weights, diff = point_weights(p_max, rows, undershoot), alpha - rows.alpha
+            loss = (weights * diff**2).sum(-1)
+            return loss, back_param(*back(2.0 * weights * diff))
+        sw, back_sweep = sweep_fn(gamma, h)
+        args = (sw.p_star, sw.alpha, rows.p, rows.alpha, undershoot)
+        loss, back_loss = pullback(InterpolatedLoss, needs, *args)
+        g_p, g_alpha = back_loss(torch.ones_like(loss))[:2]
+        return loss, back_param(*back_sweep(g_p, g_alpha))
+
+    return fun
+
+
 def residuals(
     raw: Tensor,
     settings: CellSettings,
@@ -259,7 +298,20 @@ def residuals(
             gamma, h, settings, target.p, sweep_fn=fn, load_fn=model.newton_load
         )
         weight = point_weights(p_max, target, undershoot).sqrt()  # (B, M)
-    rep = raw.detach().repeat_interleave(m, 0).requires_grad_(True)
+    rep = raw.detach().repeat_interleave(m, 0)
+    closed = model.load_area_pullback(settings)
+    if closed is not None and not model.placed:  # the same Jacobian with no graph
+        g_rep, h_rep, back_param = param.to_design_pullback(rep, settings)
+        p_rep, d_rep, p_max_rep = (
+            target.p.reshape(-1, 1),
+            delta.reshape(-1, 1),
+            p_max.repeat_interleave(m),
+        )
+        alpha, back = at_delta_pullback(closed, g_rep, h_rep, p_rep, d_rep, p_max_rep)
+        jac = back_param(*back(torch.ones_like(alpha)))
+        r = weight * (alpha.view(b, m) - target.alpha)
+        return r, weight[..., None] * jac.view(b, m, -1)
+    rep.requires_grad_(True)
     g_rep, h_rep = param.to_design(rep, settings, sort=model.placed)
     alpha = at_delta(
         g_rep,
@@ -409,10 +461,16 @@ def refine(
                 loss = 0.5 * (loss + made.view(-1, k).mean(-1))
             return loss if extra_loss is None else loss + extra_loss(gamma, h, settings)
 
+        closed = None
+        if perturb is None and extra_loss is None:
+            closed = _stage_value_and_grad(
+                model, param, settings, target, kappa, rs.undershoot_weight
+            )
         x = lbfgs.minimize(
-            fun,
+            closed or fun,
             x,
             indexed=True,
+            gives_grad=closed is not None,
             lr=rs.lr,
             max_iter=rs.steps_per_stage * rs.iterations,
             tol_stall=rs.tol_stall,

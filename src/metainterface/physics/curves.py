@@ -19,6 +19,7 @@ from torch import Tensor
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.metrics import interp
 from metainterface.physics.sneddon import dlog_kc, engagement, indentation, log_kc
+from metainterface.physics.tape import Pullback, pullback
 
 
 @dataclass(frozen=True)
@@ -201,6 +202,33 @@ def sweep(
     return Sweep(
         delta=delta, p_star=p_star, alpha=alpha, stiffness=stiffness, load_slope=load_slope
     )
+
+
+def sweep_pullback(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    *,
+    smooth: float | None = None,
+    delta: Tensor | None = None,
+) -> tuple[Sweep, Pullback]:
+    """:func:`sweep` and its pullback, ``back(g_p, g_alpha)`` -> the gradients (B, N) of
+    gamma and h for upstream gradients (B, K) of P* and alpha (either may be None; S* is
+    taken as a constant): the sweep's own closed-form backward, anchoring included, with no
+    graph (:mod:`~metainterface.physics.tape`)."""
+    if delta is None:
+        delta = delta_grid(settings, dtype=gamma.dtype, device=gamma.device)
+    low = h.min(dim=-1, keepdim=True)  # anchor(h), with the index its gradient goes to
+    needs = (True, True, False, False, False, False)
+    args = (gamma, h - low.values, delta, smooth, settings.radius, settings.nominal_area)
+    (p_star, alpha, stiffness, load_slope), back = pullback(_SweepFunction, needs, *args)
+
+    def back_design(g_p: Tensor | None, g_alpha: Tensor | None) -> tuple[Tensor, Tensor]:
+        g_gamma, g_h = back(g_p, g_alpha, None, None)[:2]
+        return g_gamma, g_h.scatter_add(-1, low.indices, -g_h.sum(-1, keepdim=True))
+
+    sw = Sweep(delta=delta, p_star=p_star, alpha=alpha, stiffness=stiffness, load_slope=load_slope)
+    return sw, back_design
 
 
 class _SweepFunction(torch.autograd.Function):

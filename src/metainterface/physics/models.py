@@ -45,6 +45,7 @@ from metainterface.physics.jkr import check_adhesion
 from metainterface.physics.labels import from_label
 from metainterface.physics.metrics import interp
 from metainterface.physics.sneddon import area
+from metainterface.physics.tape import Pullback
 
 #: Delta samples of the dense sweep that BEM loads are interpolated on (:meth:`model_curve`).
 N_DELTA_DENSE = 8193
@@ -105,6 +106,14 @@ class ForwardModel(ABC):
         """The sweep where only P* and alpha are needed (S* may be NaN); a model overrides
         it where leaving S* out is cheaper."""
         return self.sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta)
+
+    def load_area_pullback(
+        self, settings: CellSettings, smooth: float | None = None
+    ) -> Callable[..., tuple[Sweep, Pullback]] | None:
+        """``f(gamma, h, delta=None)`` -> the sweep and its closed-form pullback in P* and
+        alpha (:func:`~metainterface.physics.curves.sweep_pullback`); None where the model
+        has none (autograd then)."""
+        return None
 
     @property
     def takes_adhesion(self) -> bool:
@@ -326,6 +335,11 @@ class Independent(ForwardModel):
         if self.adhesion:
             return self._adhesive_sweep(gamma, h, settings, n_delta=n_delta, delta=delta)[0]
         return curves.sweep(gamma, h, settings, smooth=smooth, n_delta=n_delta, delta=delta)
+
+    def load_area_pullback(self, settings, smooth=None):
+        if self.adhesion:
+            return None
+        return functools.partial(curves.sweep_pullback, settings=settings, smooth=smooth)
 
     def newton_load(self, gamma, h, settings):
         # without adhesion: P* and its slope alone, ~12 operations a step against ~35

@@ -14,6 +14,7 @@ from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import Sweep, _contact_floor, anchor, delta_grid, sweep
 from metainterface.physics.metrics import interp
 from metainterface.physics.sneddon import log_kc
+from metainterface.physics.tape import Pullback
 
 #: Newton steps at most in :func:`at_pressures`, and its tolerance on |P*(Delta) - p| / p
 #: (alpha then errs by ~1e-20 after the final step in alpha). From the interpolated start
@@ -194,6 +195,33 @@ def at_delta(
     fixed p = partial alpha/partial theta - (1/S*) partial P*/partial theta.
     """
     sw = (sweep_fn or sweep)(gamma, h, settings, delta=delta)
+    return replace(sw, alpha=_step(sw, p_star, inverse_stiffness(sw, p_star, p_max)))
+
+
+def at_delta_pullback(
+    sweep_fn: Callable[..., tuple[Sweep, Pullback]],
+    gamma: Tensor,
+    h: Tensor,
+    p_star: Tensor,
+    delta: Tensor,
+    p_max: Tensor,
+) -> tuple[Tensor, Callable[[Tensor], tuple[Tensor, Tensor]]]:
+    """alpha (B, M) of :func:`at_delta` by a model's closed-form sweep (its
+    ``load_area_pullback``), and the pullback ``back(g_alpha)`` -> the gradients (B, N) of
+    gamma and h for upstream gradients (B, M) of alpha: the same gradient, with no graph."""
+    sw, back = sweep_fn(gamma, h, delta=delta)
+    inv_s = inverse_stiffness(sw, p_star, p_max)
+    return _step(sw, p_star, inv_s), lambda g: back(-g * inv_s, g)
+
+
+def _step(sw: Sweep, p_star: Tensor, inv_s: Tensor) -> Tensor:
+    """The Newton step in alpha from the sweep's state to p_star (B, M)."""
+    return sw.alpha + (p_star - sw.p_star) * inv_s
+
+
+def inverse_stiffness(sw: Sweep, p_star: Tensor, p_max: Tensor) -> Tensor:
+    """1/S* (B, M) of :func:`at_delta`'s step in alpha, detached: d alpha at fixed p is
+    d alpha - (1/S*) d P* at fixed Delta. 0 where S* is not positive or p_star >= P*_max
+    (B,) (alpha is held there)."""
     ok = (sw.stiffness > 0) & (p_star < p_max[:, None])
-    inv_s = torch.where(ok, 1.0 / torch.where(ok, sw.stiffness, 1.0), 0.0).detach()
-    return replace(sw, alpha=sw.alpha + (p_star - sw.p_star) * inv_s)
+    return torch.where(ok, 1.0 / torch.where(ok, sw.stiffness, 1.0), 0.0).detach()
