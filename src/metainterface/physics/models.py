@@ -111,7 +111,7 @@ class ForwardModel(ABC):
         self, settings: CellSettings, smooth: float | None = None
     ) -> Callable[..., tuple[Sweep, Pullback]] | None:
         """``f(gamma, h, delta=None)`` -> the sweep and its closed-form pullback in P* and
-        alpha (:func:`~metainterface.physics.curves.sweep_pullback`); None where the model
+        alpha (``physics.curves.sweep_pullback``); None where the model
         has none (autograd then)."""
         return None
 
