@@ -6,12 +6,17 @@ from zero load) as a friction law over 4 cm^2 (tau 0.3 MPa, E* 2.4 MPa, R 0.5 mm
 mJ/m^2), designed by the default path without the BEM check. The curve error weighs the
 zero-load row as one point of many; the design's note states F_0 against the law's.
 
-    PYTHONPATH=src python benchmarks/bench_offset_f0.py [--seeds 11 12 13]
+    PYTHONPATH=src python benchmarks/bench_offset_f0.py [--seeds 11 12 13] [--range 11 30]
+
+Ends with the median and largest curve error and |F_0 error| over the laws (``--range A B``:
+the seeds A..B).
 """
 
 from __future__ import annotations
 
 import argparse
+import re
+import statistics
 import tempfile
 import time
 import warnings
@@ -26,7 +31,11 @@ E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=[11, 12, 13])
+    ap.add_argument("--range", type=int, nargs=2, default=None, metavar=("FIRST", "LAST"))
     args = ap.parse_args()
+    if args.range:
+        args.seeds = list(range(args.range[0], args.range[1] + 1))
+    errors, f0_errors = [], []
     print("| law (seed) | curve error | F_0 note | seconds |")
     print("| --- | ---: | --- | ---: |")
     with tempfile.TemporaryDirectory() as tmp:
@@ -54,9 +63,20 @@ def main() -> None:
                 warnings.simplefilter("ignore")
                 r = mi.design(t, verify=False, effort=mi.Effort(seed=0))
             note = next((n for n in r.notes if "friction at zero load" in n), "-")
+            errors.append(100 * r.error)
+            share = re.search(r"\(([+-][\d.e+-]+) %\)$", note)  # the note's "(+25.3 %)"
+            if share:
+                f0_errors.append(abs(float(share.group(1))))
             print(
                 f"| {seed} | {100 * r.error:.2f} % | {note} | {time.perf_counter() - start:.1f} |"
             )
+
+    if len(errors) > 1:
+        print(
+            f"\n{len(errors)} laws: curve error median {statistics.median(errors):.2f} %, "
+            f"max {max(errors):.2f} %; |F_0 error| median {statistics.median(f0_errors):.1f} %, "
+            f"max {max(f0_errors):.1f} % ({len(f0_errors)} stated)"
+        )
 
 
 if __name__ == "__main__":

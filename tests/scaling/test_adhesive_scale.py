@@ -117,10 +117,13 @@ def test_one_answer_on_reach_with_adhesion(law_csv):
     assert m_hi > E
 
 
-def test_design_scale_designs_an_offset_law_with_its_area(law_csv):
+def test_design_scale_designs_an_offset_law_with_its_area(law_csv, monkeypatch):
     """The area chosen with the cell for the offset law (its true area 4 cm^2): in the
     feasible range, the design adhesive (w / (E* R) at the chosen scale) and close. No
     hedges: they are tested elsewhere, and were a quarter of this search's JKR sweeps."""
+    # quick scores within 100 % of the best tie here, so that the finalists are designed
+    # whatever this law's quick round reads (within TIE = 10 % it may or may not)
+    monkeypatch.setattr("metainterface.scaling.choose.TIE", 1.0)
     r = mi.design_scale(
         law_csv,
         area="2cm2..20cm2",

@@ -152,7 +152,9 @@ def _offset_note(result: Any, gamma: Any, h: Any, scale: float) -> tuple[str, ..
     f_design, f_law = float(zero[0, 0]) * scale, float(t.alpha[0]) * scale
     if not np.isfinite(f_design):
         return ()
+    law = t.meta.get("friction", {}) if isinstance(t.meta, dict) else {}
+    how = ", extrapolated from its first two rows" if law.get("offset") == "extrapolated" else ""
     return (
-        f"adhesion: friction at zero load {f_design:.3g} N, the law's {f_law:.3g} N "
+        f"adhesion: friction at zero load {f_design:.3g} N, the law's {f_law:.3g} N{how} "
         f"({100 * (f_design / f_law - 1):+.3g} %)",
     )

@@ -173,6 +173,10 @@ def design(
         from metainterface.inverse.reseed import reseed
 
         results = reseed(results, rs, extra_loss, model, seed)
+    if refine_designs and perturb is None and rs.offset and model.adhesion:  # a law's F_0
+        from metainterface.inverse.offset import offset_polish
+
+        results = offset_polish(results, rs, extra_loss, model)
     if z_step is not None:
         results = printable(
             results, z_step, refine_settings or RefineSettings(), extra_loss, model, perturb, dev

@@ -97,6 +97,9 @@ class RefineSettings:
     # (``inverse.reseed``), as costly as the design itself; a scale search's quick candidates
     # skip them (they rank scales; the chosen one is designed in full, re-seed included)
     reseed: bool = True
+    # and an adhesive offset law's design a last polish with its F_0 weighted
+    # (``inverse.offset``), which the quick candidates skip too
+    offset: bool = True
 
     def __post_init__(self) -> None:
         if self.polish_method not in POLISH_METHODS:
@@ -136,10 +139,12 @@ class RefineSettings:
 
 @dataclass(frozen=True)
 class TargetGrid:
-    """Targets on their own uniform pressure grids: p, alpha (T, G)."""
+    """Targets on their own uniform pressure grids: p, alpha (T, G); weight (T, G), each
+    point's weight in the loss relative to the others (None: all 1)."""
 
     p: Tensor
     alpha: Tensor
+    weight: Tensor | None = None
 
     @classmethod
     def from_curves(cls, curves: list[tuple[np.ndarray, np.ndarray]], points: int) -> TargetGrid:
@@ -153,11 +158,13 @@ class TargetGrid:
         )
 
     def rows(self, index: Tensor) -> TargetGrid:
-        return TargetGrid(self.p[index], self.alpha[index])
+        weight = None if self.weight is None else self.weight[index]
+        return TargetGrid(self.p[index], self.alpha[index], weight)
 
     def to(self, device: torch.device) -> TargetGrid:
         """The grid on ``device``."""
-        return TargetGrid(self.p.to(device), self.alpha.to(device))
+        weight = None if self.weight is None else self.weight.to(device)
+        return TargetGrid(self.p.to(device), self.alpha.to(device), weight)
 
 
 def _rows(target: TargetGrid, idx: Tensor) -> TargetGrid:
@@ -183,15 +190,21 @@ def masked_loss(
     model = get_model(model)
     if smooth is not None:
         sw = model.load_area(gamma, h, settings, smooth=smooth)
-        return InterpolatedLoss.apply(sw.p_star, sw.alpha, target.p, target.alpha, undershoot)
+        p = model.loads_read(target.p)  # an adhesive sweep's zero load: its plateau's end
+        return InterpolatedLoss.apply(
+            sw.p_star, sw.alpha, p, target.alpha, undershoot, target.weight
+        )
     alpha, p_max = model.alpha_at(gamma, h, settings, target.p, exact=True)
     return (point_weights(p_max, target, undershoot) * (alpha - target.alpha) ** 2).sum(-1)
 
 
 def point_weights(p_max: Tensor, target: TargetGrid, undershoot: float = 0.1) -> Tensor:
     """Each target point's weight in :func:`masked_loss` (B, M): 1 where the design's curve
-    reaches it (p <= P*_max (B,)), ``undershoot`` beyond, over sum(weights) mean(alpha_t^2)."""
+    reaches it (p <= P*_max (B,)), ``undershoot`` beyond, times the grid's own weight if it
+    has one, over sum(weights) mean(alpha_t^2)."""
     w = torch.where(target.p <= p_max[:, None], 1.0, undershoot)
+    if target.weight is not None:
+        w = w * target.weight
     return w / (w.sum(-1, keepdim=True) * (target.alpha**2).mean(-1, keepdim=True))
 
 
@@ -208,14 +221,14 @@ class InterpolatedLoss(torch.autograd.Function):
     """
 
     @staticmethod
-    def forward(ctx, p_sweep, alpha_sweep, p, alpha_t, undershoot):
+    def forward(ctx, p_sweep, alpha_sweep, p, alpha_t, undershoot, weight=None):
         zero = torch.zeros_like(p_sweep[:, :1])
         xp, fp = torch.cat([zero, p_sweep], -1), torch.cat([zero, alpha_sweep], -1)
         idx, w, width, ratio = interp_weights(p, xp)
         f0 = fp.gather(-1, idx - 1)
         rise = fp.gather(-1, idx) - f0
         diff = f0 + w * rise - alpha_t
-        weights = point_weights(xp[:, -1], TargetGrid(p, alpha_t), undershoot)
+        weights = point_weights(xp[:, -1], TargetGrid(p, alpha_t, weight), undershoot)
         inside = (width > 0) & (ratio >= 0) & (ratio <= 1)  # where w is not clamped
         slope = torch.where(inside, rise / torch.where(inside, width, 1.0), 0.0)
         ctx.save_for_backward(idx, w, slope, weights * diff)
@@ -232,7 +245,7 @@ class InterpolatedLoss(torch.autograd.Function):
         gs = ga * slope
         grad_x = ga.new_zeros(ga.shape[0], ctx.knots)
         grad_x.scatter_add_(-1, both, torch.cat([gs * w - gs, -gs * w], -1))
-        return grad_x[:, 1:], grad_f[:, 1:], None, None, None
+        return grad_x[:, 1:], grad_f[:, 1:], None, None, None, None
 
 
 def _stage_value_and_grad(
@@ -250,7 +263,7 @@ def _stage_value_and_grad(
     sweep_fn = model.load_area_pullback(settings, smooth)
     if sweep_fn is None or model.placed:
         return None
-    needs = (True, True, False, False, False)
+    needs = (True, True, False, False, False, False)
 
     def fun(z: Tensor, idx: Tensor) -> tuple[Tensor, Tensor]:
         rows = _rows(target, idx)
@@ -265,7 +278,7 @@ def _stage_value_and_grad(
             loss = (weights * diff**2).sum(-1)
             return loss, back_param(*back(2.0 * weights * diff))
         sw, back_sweep = sweep_fn(gamma, h)
-        args = (sw.p_star, sw.alpha, rows.p, rows.alpha, undershoot)
+        args = (sw.p_star, sw.alpha, rows.p, rows.alpha, undershoot, rows.weight)
         loss, back_loss = pullback(InterpolatedLoss, needs, *args)
         g_p, g_alpha = back_loss(torch.ones_like(loss))[:2]
         return loss, back_param(*back_sweep(g_p, g_alpha))
@@ -289,8 +302,11 @@ def residuals(
     at one Delta each, and one backward pass of the summed alphas gives every row of J: the
     cost of one gradient evaluation, not M.
     """
-    b, m = target.p.shape
     model = get_model(model)
+    # an adhesive model reads zero load where the force holds it, as alpha_at and the
+    # reported error do (the plateau P* = 0 of a snap-in reads less area)
+    target = replace(target, p=model.loads_read(target.p))
+    b, m = target.p.shape
     fn = model.sweep
     with torch.no_grad():
         gamma, h = param.to_design(raw, settings, sort=model.placed)

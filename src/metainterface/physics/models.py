@@ -51,6 +51,10 @@ from metainterface.physics.tape import Pullback
 N_DELTA_DENSE = 8193
 
 
+#: The fraction of the top load at which an adhesive model reads zero load (loads_read).
+ZERO_LOAD = 1e-12
+
+
 class ForwardModel(ABC):
     """The protocol of a forward model: subclass it, implement the two sweeps, register it.
 
@@ -257,14 +261,21 @@ class ForwardModel(ABC):
         # loads go in ascending (a tolerance study asks for two grids in one call)
         order = torch.argsort(p_star, dim=-1)
         ascending = p_star.gather(-1, order)
-        # zero load: where the rising force first holds, the end of the plateau at P* = 0
-        # (not a state the snap-in passes), at 1e-12 of the top load asked, else of P*_max
+        # zero load: where the rising force first holds (loads_read), of the top load asked,
+        # else of P*_max
         top = ascending[..., -1:]
         if bool((top <= 0).any()):
             top = torch.where(top > 0, top, self.load_area(gamma, h, settings).p_star[:, -1:])
-        ascending = torch.maximum(ascending, 1e-12 * top)
+        ascending = torch.maximum(ascending, ZERO_LOAD * top)
         alpha, p_max = pressures.alpha_at(gamma, h, settings, ascending, sweep_fn=fn, **opts)
         return alpha.gather(-1, torch.argsort(order, dim=-1)), p_max
+
+    def loads_read(self, p_star: Tensor) -> Tensor:
+        """Ascending pressures (B, M), the last positive, as :meth:`alpha_at` reads them: as
+        given, but an adhesive model reads zero load at ``ZERO_LOAD`` of the top load, where
+        the rising force first holds it (the end of the snap-in's plateau at P* = 0), not in
+        a state the snap-in passes through. Losses on a target's grid read it so too."""
+        return torch.maximum(p_star, ZERO_LOAD * p_star[..., -1:]) if self.adhesion else p_star
 
     def newton_load(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
         """``load(delta=...)``: P* and ``load_slope`` of (B, N) designs at Deltas (B, M), for

@@ -26,7 +26,7 @@ CANDIDATES = 5
 #: re-seeding of idle asperities (it cost as much as the candidates' designs, and the
 #: chosen scale's full design re-seeds; ``benchmarks/results/loaded.md``).
 QUICK = RefineSettings(
-    stages=2, steps_per_stage=3, iterations=20, polish_iterations=20, reseed=False
+    stages=2, steps_per_stage=3, iterations=20, polish_iterations=20, reseed=False, offset=False
 )
 #: With adhesion (a snap-in moves a quick score more than the scales differ) the FINALISTS
 #: best quick scores within TIE of the best are designed in full, no BEM check, and the best

@@ -127,6 +127,9 @@ class FrictionTarget:
     settings: CellSettings = field(default_factory=CellSettings)
     fit: LawFit | None = None
     work_of_adhesion: float = 0.0
+    # the zero-load row F_f(0) > 0 was extrapolated from the first two (the law began above
+    # zero load), not given
+    offset_extrapolated: bool = False
 
     @property
     def adhesion(self) -> float:
@@ -154,6 +157,7 @@ class FrictionTarget:
                 if self.work_of_adhesion
                 else {}
             ),
+            **({"offset": "extrapolated"} if self.offset_extrapolated else {}),
         }
 
 
@@ -268,12 +272,14 @@ def friction_target(
             argument="work_of_adhesion",
         )
     law, lf = prepare_law(law, fit, offset=w > 0)
+    extrapolated = False
     if include_origin and law.normal_force[0] > 0:
         f0 = 0.0
         if w > 0 and law.normal_force.size >= 2:  # the offset, extrapolated
             fn, ff = law.normal_force, law.friction_force
             slope = (ff[1] - ff[0]) / (fn[1] - fn[0])
             f0 = float(min(max(ff[0] - slope * fn[0], 0.0), ff[0]))
+            extrapolated = f0 > 0
         law = FrictionLaw(
             normal_force=np.concatenate([[0.0], law.normal_force]),
             friction_force=np.concatenate([[f0], law.friction_force]),
@@ -319,6 +325,7 @@ def friction_target(
         settings=settings,
         fit=lf,
         work_of_adhesion=w,
+        offset_extrapolated=extrapolated,
     )
 
 
