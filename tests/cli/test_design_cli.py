@@ -156,3 +156,26 @@ def test_design_cli_area_auto_and_fit(tmp_path, capsys):
     assert not (fixed / "design.json").exists()
     assert main([*base, "--area", "auto", "--target", "linear", "--out", str(fixed)]) == 2
     assert "alone" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--work-of-adhesion", "-5mJ/m2", "--work-of-adhesion must be >= 0"),
+        ("--modulus", "-2.4MPa", "--modulus must be > 0"),
+        ("--radius", "-.5mm", "--radius must be > 0"),
+    ],
+)
+def test_a_negative_quantity_is_told_its_range(tmp_path, capsys, option, value, message):
+    """A negative value with its unit is read as a value and answered with its range (not
+    argparse's "expected one argument"), before anything is designed."""
+    csv = tmp_path / "law.csv"
+    csv.write_text("normal_force,friction_force\n" + "".join(f"{f},{f}\n" for f in range(1, 12)))
+    scale = {"--shear-strength": "0.3MPa", "--modulus": "2.4MPa", "--radius": "0.5mm"}
+    scale[option] = value
+    argv = ["design", "--friction-csv", str(csv), "--area", "4cm2", "--out", str(tmp_path / "o")]
+    argv += [x for kv in scale.items() for x in kv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()

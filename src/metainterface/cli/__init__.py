@@ -16,6 +16,7 @@ import atexit
 import contextlib
 import importlib
 import os
+import re
 import sys
 import threading
 import warnings
@@ -66,7 +67,16 @@ OPTION_NAMES = {
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors: ``metainterface design: error: argument --starts: ...``."""
+    """argparse with one-line errors: ``metainterface design: error: argument --starts: ...``.
+
+    A value that starts with a minus and a digit is a value, units and all
+    (``--work-of-adhesion -5mJ/m2``), so that its own check says what range it must be in,
+    not "expected one argument" (argparse takes only bare numbers so; no option here starts
+    with a digit)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {' '.join(message.split())}\n")
