@@ -7,7 +7,8 @@ and F_0 is set mostly by how many asperities are in contact at zero load (those 
 sit below the zero-load indentation Delta_0): a count, which no gradient changes. Designs
 met the curve and missed F_0 by 13 % (median) and far more on some laws.
 
-So a design of an adhesive target with F_0 > 0 gets a last polish (Levenberg-Marquardt on
+So a design of an adhesive target with F_0 > 0, unless it is within ``F0_TOL`` of F_0
+already, gets a last polish (Levenberg-Marquardt on
 the exact law, as the pipeline's) with the zero-load point weighted ``OFFSET_WEIGHT`` times,
 from the design itself and from copies of it with one or two asperities more or fewer in
 contact at zero load (the next tips lowered below Delta_0, or the last ones lifted above
@@ -94,8 +95,12 @@ def offset_polish(
 ) -> list[DesignResult]:
     """The results, each adhesive design of a target with F_0 > 0 replaced by one nearer
     F_0 where the curve allows it (see the module docstring)."""
-    todo = [i for i, r in enumerate(results) if has_offset(r)]
-    if not model.adhesion or not todo:
+    if not model.adhesion:
+        return results
+    # a design already within F0_TOL of F_0 has nothing to gain here
+    missed = {i: _f0_miss(r, model) for i, r in enumerate(results) if has_offset(r)}
+    todo = [i for i, miss in missed.items() if miss > F0_TOL]
+    if not todo:
         return results
     s = results[0].settings
     gammas, heights, owner = [], [], []
@@ -131,7 +136,7 @@ def offset_polish(
     for j, i in enumerate(todo):
         r = results[i]
         mine = (owner_t == j).nonzero(as_tuple=True)[0]
-        before = _f0_miss(r, model)
+        before = missed[i]
         within = err[mine] <= max(r.error * (1 + OFFSET_SLACK), r.error + OFFSET_FLOOR)
         # nearest F_0 first, all within F0_TOL counting as met; then the smaller error
         keys = [(max(float(miss[k]), F0_TOL), float(err[k]), int(k)) for k in mine[within]]
