@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -33,3 +33,7 @@ class DesignResult:
     quantisation: dict | None = None
     # which network (and view of the target) made the zero-shot design; "" for baselines
     zero_shot_from: str = ""
+
+    def redesigned(self, gamma: np.ndarray, h: np.ndarray, error: float, note: str) -> DesignResult:
+        """This result with another design (gamma, h (N,), its error) and a note on why."""
+        return replace(self, gamma=gamma.copy(), h=h.copy(), error=error, notes=(*self.notes, note))

@@ -149,13 +149,7 @@ def offset_polish(
             f"{100 * before:.3g} % -> {100 * f0:.3g} %, error {100 * r.error:.3g} % -> "
             f"{100 * e:.3g} %"
         )
-        out[i] = replace(
-            r,
-            gamma=g1[row].numpy().copy(),
-            h=h1[row].numpy().copy(),
-            error=e,
-            notes=(*r.notes, note),
-        )
+        out[i] = r.redesigned(g1[row].numpy(), h1[row].numpy(), e, note)
     return out
 
 

@@ -18,7 +18,6 @@ reported.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -117,13 +116,7 @@ def reseed(
                 f"{_count(int(left[j, b]))} idle now (error {100 * r.error:.3g} % -> "
                 f"{100 * e:.3g} %)"
             )
-            out[i] = replace(
-                r,
-                gamma=g1[row].numpy().copy(),
-                h=h1[row].numpy().copy(),
-                error=e,
-                notes=(*r.notes, note),
-            )
+            out[i] = r.redesigned(g1[row].numpy(), h1[row].numpy(), e, note)
     return out
 
 
