@@ -12,6 +12,7 @@ from typing import Any
 
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.envelope import target_adhesion
+from metainterface.inverse.offset import extrapolated
 from metainterface.physics.models import ForwardModel
 
 
@@ -152,8 +153,7 @@ def _offset_note(result: Any, gamma: Any, h: Any, scale: float) -> tuple[str, ..
     f_design, f_law = float(zero[0, 0]) * scale, float(t.alpha[0]) * scale
     if not np.isfinite(f_design):
         return ()
-    law = t.meta.get("friction", {}) if isinstance(t.meta, dict) else {}
-    how = ", extrapolated from its first two rows" if law.get("offset") == "extrapolated" else ""
+    how = ", extrapolated from its first two rows" if extrapolated(t) else ""
     return (
         f"adhesion: friction at zero load {f_design:.3g} N, the law's {f_law:.3g} N{how} "
         f"({100 * (f_design / f_law - 1):+.3g} %)",

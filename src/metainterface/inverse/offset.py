@@ -38,6 +38,7 @@ from metainterface.physics.pressures import solve_delta
 
 if TYPE_CHECKING:
     from metainterface.inverse.designed import DesignResult
+    from metainterface.inverse.targets import Target
 
 DTYPE = torch.float64
 #: The zero-load point's weight in the offset polish, relative to each other point's.
@@ -51,13 +52,18 @@ F0_TOL = 0.01
 COUNT_STEPS = 2
 
 
+def extrapolated(target: Target) -> bool:
+    """Whether the target's F_0 was extrapolated from its law's first two rows (a law that
+    begins above zero load; ``meta["friction"]["offset"]``), not given."""
+    law = target.meta.get("friction", {}) if isinstance(target.meta, dict) else {}
+    return law.get("offset") == "extrapolated"
+
+
 def has_offset(result: DesignResult) -> bool:
     """Whether the result's target starts at zero load with friction (F_0 > 0) that its
-    law gives (not one extrapolated from a law that begins above zero load)."""
+    law gives (not :func:`extrapolated`)."""
     t = result.target
-    law = t.meta.get("friction", {}) if isinstance(t.meta, dict) else {}
-    given = law.get("offset") != "extrapolated"
-    return bool(t.p_star.size and t.p_star[0] == 0 and t.alpha[0] > 0 and given)
+    return bool(t.p_star.size and t.p_star[0] == 0 and t.alpha[0] > 0 and not extrapolated(t))
 
 
 def contact_starts(

@@ -266,16 +266,19 @@ class ForwardModel(ABC):
         top = ascending[..., -1:]
         if bool((top <= 0).any()):
             top = torch.where(top > 0, top, self.load_area(gamma, h, settings).p_star[:, -1:])
-        ascending = torch.maximum(ascending, ZERO_LOAD * top)
+        ascending = self.loads_read(ascending, top)
         alpha, p_max = pressures.alpha_at(gamma, h, settings, ascending, sweep_fn=fn, **opts)
         return alpha.gather(-1, torch.argsort(order, dim=-1)), p_max
 
-    def loads_read(self, p_star: Tensor) -> Tensor:
-        """Ascending pressures (B, M), the last positive, as :meth:`alpha_at` reads them: as
-        given, but an adhesive model reads zero load at ``ZERO_LOAD`` of the top load, where
-        the rising force first holds it (the end of the snap-in's plateau at P* = 0), not in
-        a state the snap-in passes through. Losses on a target's grid read it so too."""
-        return torch.maximum(p_star, ZERO_LOAD * p_star[..., -1:]) if self.adhesion else p_star
+    def loads_read(self, p_star: Tensor, top: Tensor | None = None) -> Tensor:
+        """Ascending pressures (B, M) as :meth:`alpha_at` reads them: as given, but an
+        adhesive model reads zero load at ``ZERO_LOAD`` of the top load (``top`` (B, 1), by
+        default the last pressure), where the rising force first holds it (the end of the
+        snap-in's plateau at P* = 0), not in a state the snap-in passes through. Losses on
+        a target's grid read it so too."""
+        if not self.adhesion:
+            return p_star
+        return torch.maximum(p_star, ZERO_LOAD * (p_star[..., -1:] if top is None else top))
 
     def newton_load(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
         """``load(delta=...)``: P* and ``load_slope`` of (B, N) designs at Deltas (B, M), for
