@@ -177,7 +177,8 @@ def test_hedge_starts_jitter_the_zero_shot_design():
 def test_a_start_on_the_bounds_can_still_move():
     # gammas on both bounds and all gaps 0, what the surrogate outputs for the linear law:
     # within 1e-4 of the bounds the sigmoid and softplus were flat and L-BFGS never moved
-    from metainterface.inverse.refine import TargetGrid, refine, relative_error
+    from metainterface.inverse.losses import TargetGrid, relative_error
+    from metainterface.inverse.refine import refine
 
     target = builtin_target("linear")
     grid = TargetGrid.from_curves([(target.p_star, target.alpha)], 128)

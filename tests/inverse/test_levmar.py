@@ -5,8 +5,8 @@ import torch
 
 from metainterface.inverse import builtin_target
 from metainterface.inverse.levmar import least_squares
+from metainterface.inverse.losses import TargetGrid, masked_loss, residuals
 from metainterface.inverse.params import FULL, HERTZ
-from metainterface.inverse.refine import TargetGrid, masked_loss, residuals
 from metainterface.physics import CellSettings
 
 F64 = torch.float64

@@ -7,15 +7,9 @@ import torch
 
 import metainterface as mi
 from metainterface.inverse import builtin_target
+from metainterface.inverse.losses import InterpolatedLoss, TargetGrid, masked_loss
 from metainterface.inverse.params import FULL, HERTZ, FixedHeights, snap_heights
-from metainterface.inverse.refine import (
-    InterpolatedLoss,
-    RefineSettings,
-    TargetGrid,
-    masked_loss,
-    polish,
-    refine,
-)
+from metainterface.inverse.refine import RefineSettings, polish, refine
 from metainterface.physics import CellSettings, Independent
 from metainterface.physics.pressures import alpha_at
 

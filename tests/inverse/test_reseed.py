@@ -42,7 +42,7 @@ def test_a_design_with_an_idle_asperity_is_re_seeded_no_worse():
     (target,) = design_targets(["cell"], gamma, h, S, points=129)
     h_bad = h.clone()
     h_bad[0, -1] = 3 * S.delta_max
-    from metainterface.inverse.refine import TargetGrid, relative_error
+    from metainterface.inverse.losses import TargetGrid, relative_error
 
     grid = TargetGrid.from_curves([(target.p_star, target.alpha)], 128)
     err = float(relative_error(gamma, h_bad, S, grid, MODEL)[0])

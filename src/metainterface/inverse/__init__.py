@@ -5,9 +5,10 @@ from metainterface.inverse.envelope import (
     reachability_warnings,
     reachable_envelope,
 )
+from metainterface.inverse.losses import TargetGrid, relative_error
 from metainterface.inverse.params import FULL, HERTZ, Parameterisation
 from metainterface.inverse.pipeline import METHODS, DesignResult, design, predict
-from metainterface.inverse.refine import RefineSettings, TargetGrid, relative_error
+from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import (
     BUILTIN_TARGETS,
     Target,

@@ -12,15 +12,10 @@ import torch
 from torch import Tensor
 
 from metainterface.inverse.designed import DesignResult
+from metainterface.inverse.losses import TargetGrid, relative_error, robust_error
 from metainterface.inverse.params import DTYPE, FixedHeights, snap_heights
 from metainterface.inverse.perturb import Perturbation
-from metainterface.inverse.refine import (
-    RefineSettings,
-    TargetGrid,
-    polish,
-    relative_error,
-    robust_error,
-)
+from metainterface.inverse.refine import RefineSettings, polish
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.models import ForwardModel
 

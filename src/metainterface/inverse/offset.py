@@ -28,8 +28,9 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from metainterface.inverse.losses import TargetGrid
 from metainterface.inverse.params import FULL
-from metainterface.inverse.refine import RefineSettings, TargetGrid, polish
+from metainterface.inverse.refine import RefineSettings, polish
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import anchor
 from metainterface.physics.metrics import curve_error

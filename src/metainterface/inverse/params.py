@@ -151,7 +151,7 @@ class FixedHeights(Parameterisation):
 
     def _heights(self, count: int) -> Tensor:
         # the Levenberg-Marquardt Jacobian evaluates each row several times, rows repeated
-        # in place (``refine.residuals``): the heights follow
+        # in place (``losses.residuals``): the heights follow
         b = self.h.shape[0]
         return self.h if count == b else self.h.repeat_interleave(count // b, 0)
 

@@ -22,21 +22,14 @@ from metainterface._names import METHOD_NAMES
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.designed import DesignResult
 from metainterface.inverse.layers import printable
+from metainterface.inverse.losses import TargetGrid, relative_error, robust_error
 from metainterface.inverse.params import (
     FULL,
     HERTZ,
     Parameterisation,
 )
 from metainterface.inverse.perturb import Perturbation
-from metainterface.inverse.refine import (
-    HEDGE_ERROR,
-    RefineSettings,
-    TargetGrid,
-    polish,
-    refine,
-    relative_error,
-    robust_error,
-)
+from metainterface.inverse.refine import HEDGE_ERROR, RefineSettings, polish, refine
 from metainterface.inverse.starts import (
     best_views,
     hedge_starts,

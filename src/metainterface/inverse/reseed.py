@@ -24,8 +24,9 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from metainterface.inverse.losses import TargetGrid, relative_error
 from metainterface.inverse.params import FULL
-from metainterface.inverse.refine import RefineSettings, TargetGrid, polish, refine, relative_error
+from metainterface.inverse.refine import RefineSettings, polish, refine
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.metrics import interp
 from metainterface.physics.models import ForwardModel

@@ -33,9 +33,9 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from metainterface.inverse.losses import TargetGrid, relative_error
 from metainterface.inverse.params import DTYPE
 from metainterface.inverse.perturb import REACH, Perturbation, loaded
-from metainterface.inverse.refine import TargetGrid, relative_error
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.metrics import curve_error
 from metainterface.physics.models import ForwardModel
@@ -111,7 +111,7 @@ def spread(
     """Monte Carlo and first-order spread of one design (N,) under ``pert``.
 
     The band's pressures are ``points`` uniform ones on [0, P*_max] of the nominal design;
-    the errors are :func:`~metainterface.inverse.refine.relative_error` on the reference's
+    the errors are :func:`~metainterface.inverse.losses.relative_error` on the reference's
     grid (the target's, or the nominal curve's). The nominal design and every sample are
     evaluated together: one batch of S + 1 rows at the band's and the reference's pressures,
     on ``device`` (default the CPU; ``pert``'s draws are moved there). numpy out.

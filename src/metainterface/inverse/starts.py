@@ -13,14 +13,11 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from metainterface.inverse.losses import TargetGrid, relative_error
 from metainterface.inverse.params import (
     DTYPE,
     FULL,
     Parameterisation,
-)
-from metainterface.inverse.refine import (
-    TargetGrid,
-    relative_error,
 )
 from metainterface.inverse.targets import Target, target_features
 from metainterface.physics.cell import CellSettings

@@ -46,8 +46,9 @@ import torch
 from torch import Tensor
 
 from metainterface.errors import MetainterfaceError
+from metainterface.inverse.losses import TargetGrid, relative_error
 from metainterface.inverse.params import DTYPE, FULL, Parameterisation
-from metainterface.inverse.refine import RefineSettings, TargetGrid, polish, relative_error
+from metainterface.inverse.refine import RefineSettings, polish
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.models import ForwardModel, get_model
