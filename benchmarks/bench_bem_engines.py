@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from metainterface.physics import Design
-from metainterface.physics.models import get_model
+from metainterface.physics.registry import get_model
 from metainterface.validation import solve_path, torch_threads
 from metainterface.validation.heightmap import height_map
 

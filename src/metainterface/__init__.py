@@ -115,12 +115,12 @@ _HOMES: dict[str, str] = {
     "Target": "metainterface.inverse.targets",
     "CellSettings": "metainterface.physics.cell",
     "Design": "metainterface.physics.cell",
-    "MODELS": "metainterface.physics.models",
+    "MODELS": "metainterface.physics.registry",
     "ForwardModel": "metainterface.physics.models",
     "Independent": "metainterface.physics.models",
     "Interacting": "metainterface.physics.models",
-    "get_model": "metainterface.physics.models",
-    "register_model": "metainterface.physics.models",
+    "get_model": "metainterface.physics.registry",
+    "register_model": "metainterface.physics.registry",
     "tune_allocator": "metainterface.runtime",
     "set_threads": "metainterface._threads",
     "TrainConfig": "metainterface.surrogate.config",
@@ -153,14 +153,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.measure.result import MeasureResult
     from metainterface.measure.run import measure
     from metainterface.physics.cell import CellSettings, Design
-    from metainterface.physics.models import (
-        MODELS,
-        ForwardModel,
-        Independent,
-        Interacting,
-        get_model,
-        register_model,
-    )
+    from metainterface.physics.models import ForwardModel, Independent, Interacting
+    from metainterface.physics.registry import MODELS, get_model, register_model
     from metainterface.runtime import tune_allocator
     from metainterface.scaling.choose import design_scale, feasible_scale
     from metainterface.scaling.search import FeasibleScale

@@ -2,13 +2,13 @@
 
 ``metainterface --help`` and an argument error must answer without importing torch, so the
 choices of ``--physics``, ``--method`` and ``--format`` are spelt here; the library's
-registries (``physics.models.MODELS``, ``inverse.pipeline.METHODS``, ``io.export.FORMATS``)
+registries (``physics.registry.MODELS``, ``inverse.pipeline.METHODS``, ``io.export.FORMATS``)
 are built on them, and tests/test_cli_startup.py checks that the two agree.
 """
 
 from __future__ import annotations
 
-#: The built-in forward models (``physics.models.MODELS``), and the one used where none is named.
+#: The built-in forward models (``physics.registry.MODELS``), and the one used where none is named.
 MODEL_NAMES: tuple[str, ...] = ("independent", "interacting")
 DEFAULT_MODEL = "independent"
 #: The design methods (``inverse.pipeline.METHODS``).

@@ -8,7 +8,7 @@ import torch
 
 from metainterface.inverse import TargetGrid, builtin_target, relative_error
 from metainterface.physics import CellSettings
-from metainterface.physics.models import get_model
+from metainterface.physics.registry import get_model
 
 S = CellSettings()
 

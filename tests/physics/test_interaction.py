@@ -23,7 +23,8 @@ from metainterface.physics.interaction import (
     periodic_kernel,
     sweep_interacting,
 )
-from metainterface.physics.models import MODELS, Independent, Interacting, get_model
+from metainterface.physics.models import Independent, Interacting
+from metainterface.physics.registry import MODELS, get_model
 
 F64 = torch.float64
 S = CellSettings()

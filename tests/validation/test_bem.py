@@ -11,7 +11,8 @@ import pytest
 from metainterface import validate_many
 from metainterface.errors import MetainterfaceError
 from metainterface.physics import CellSettings, Design
-from metainterface.physics.models import MODELS, Independent, get_model
+from metainterface.physics.models import Independent
+from metainterface.physics.registry import MODELS, get_model
 from metainterface.validation import solve_path, validate_design
 from metainterface.validation.bem import contact_area
 from metainterface.validation.heightmap import height_map

@@ -13,7 +13,7 @@ import torch
 import metainterface as mi
 from metainterface.errors import MetainterfaceError
 from metainterface.physics import CellSettings, Design
-from metainterface.physics.models import get_model
+from metainterface.physics.registry import get_model
 from metainterface.validation import get_engine, solve_path, validate_design
 from metainterface.validation import torch_bem as tb
 from metainterface.validation.heightmap import height_map

@@ -8,7 +8,7 @@ import torch
 
 from metainterface.physics import Design
 from metainterface.physics.interaction import sweep_interacting
-from metainterface.physics.models import MODELS, get_model, models_at
+from metainterface.physics.registry import MODELS, get_model, models_at
 
 EXAMPLE = str(files("metainterface") / "examples" / "example_design.json")
 

@@ -10,7 +10,7 @@ import pytest
 
 import metainterface as mi
 from metainterface.cli import main
-from metainterface.physics.models import get_model
+from metainterface.physics.registry import get_model
 from metainterface.verify import BemCheck, Verify, bem_check
 from metainterface.verify.check import curve_error
 from metainterface.verify.correct import (

@@ -20,7 +20,8 @@ import numpy as np
 
 from metainterface.calibration.sphere import Calibration, check_scales, friction_rows
 from metainterface.errors import MetainterfaceError
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 
 #: The adhesion scanned before the 1-D search, in units of E* R (0 is tried too): the
 #: adhesive model's range up to ``ADHESION_LIMIT``, 3 points a decade; then 24 a decade

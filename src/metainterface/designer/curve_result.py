@@ -14,7 +14,8 @@ import torch
 
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

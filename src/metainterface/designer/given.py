@@ -19,7 +19,8 @@ from metainterface.designer.curve_result import CURVE_STEPS, Curve, design_curve
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.limits import PressureCheck, check_pressure
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 from metainterface.units.dimensions import physical_block
 from metainterface.units.plausible import warn_unit_slips
 from metainterface.units.quantities import (

@@ -16,7 +16,8 @@ from metainterface._files.provenance import HASH_DIGITS
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.limits import PressureCheck
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 from metainterface.verify import BemCheck, Correction
 
 if TYPE_CHECKING:

@@ -42,7 +42,8 @@ from metainterface.inverse.targets import Target
 from metainterface.inverse.verdict import refuse_unreachable
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.limits import PressureCheck, check_pressure, pressure_penalty
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 from metainterface.units.dimensions import physical_block
 from metainterface.units.quantities import (
     parse_pressure,

@@ -15,7 +15,7 @@ from metainterface.designer.given import design_model
 from metainterface.designer.results import DesignResult
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
-from metainterface.physics.models import get_model
+from metainterface.physics.registry import get_model
 
 #: Files up to this size are embedded in the page (data: URIs); larger ones are linked.
 EMBED_BYTES = 8_000_000

@@ -8,7 +8,8 @@ import numpy as np
 
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 
 
 @dataclass(frozen=True)

@@ -18,8 +18,9 @@ from metainterface.inverse.params import DTYPE, FULL, Parameterisation
 from metainterface.inverse.perturb import Perturbation, loaded
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.metrics import curve_error, interp_weights
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
 from metainterface.physics.pressures import at_delta, at_delta_pullback, solve_delta
+from metainterface.physics.registry import get_model
 from metainterface.physics.tape import pullback
 
 

@@ -40,7 +40,8 @@ from metainterface.inverse.starts import (
 )
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 
 #: Design methods and the parameterisation each refines: the surrogate's prediction and the
 #: multistart in the full space, the Hertz-only baseline with gamma fixed at 2.
@@ -90,7 +91,7 @@ def design(
     the surrogate meets cost nothing extra. 0 (the default) is the paper's pipeline.
 
     ``model`` is the forward model the refinement optimises and the error is measured with
-    (a name in ``physics.models.MODELS`` or a ForwardModel); the surrogate was trained on
+    (a name in ``physics.registry.MODELS`` or a ForwardModel); the surrogate was trained on
     the independent one.
 
     ``settings`` is the cell (N, gamma bounds, Delta_max). The surrogate method uses the

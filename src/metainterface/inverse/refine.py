@@ -35,7 +35,8 @@ from metainterface.inverse.losses import (
 from metainterface.inverse.params import DTYPE, FULL, Parameterisation
 from metainterface.inverse.perturb import Perturbation, loaded
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 
 POLISH_METHODS = ("levmar", "lbfgs")
 

@@ -24,7 +24,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.measure.predict import ERROR_POINTS, curve_errors, target_of
 from metainterface.measure.register import Registration
 from metainterface.physics.cell import Design
-from metainterface.physics.models import get_model
+from metainterface.physics.registry import get_model
 
 #: Steps of the refinement with the map inside.
 REFINE_STEPS = 150

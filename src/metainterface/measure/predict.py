@@ -26,7 +26,7 @@ from metainterface.measure.scan import Scan
 from metainterface.measure.surface import lattice_surface
 from metainterface.physics.cell import Design
 from metainterface.physics.metrics import curve_error
-from metainterface.physics.models import get_model
+from metainterface.physics.registry import get_model
 from metainterface.validation import owner_map, solve_path
 
 #: Points of the uniform grid every curve error is measured on (as ``validation``'s).

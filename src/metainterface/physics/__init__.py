@@ -1,5 +1,6 @@
 """The forward model: pure, batched torch functions (no I/O)."""
 
+from metainterface._names import DEFAULT_MODEL
 from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.curves import (
     Curve,
@@ -15,18 +16,9 @@ from metainterface.physics.curves import (
     to_grid,
 )
 from metainterface.physics.metrics import coverage, curve_error, interp
-from metainterface.physics.models import (
-    DEFAULT_MODEL,
-    MODELS,
-    ForwardModel,
-    Independent,
-    Interacting,
-    ModelCurve,
-    get_model,
-    models_at,
-    register_model,
-)
+from metainterface.physics.models import ForwardModel, Independent, Interacting, ModelCurve
 from metainterface.physics.pressures import alpha_at
+from metainterface.physics.registry import MODELS, get_model, models_at, register_model
 from metainterface.physics.sneddon import (
     area,
     contact_radius,

@@ -42,7 +42,8 @@ from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, open_fields, require_xarray, write_fields
 from metainterface.physics.cell import Design
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 from metainterface.plots import plot_validation, save_figure
 from metainterface.validation.bem import (
     MAX_ITER,

@@ -31,7 +31,8 @@ from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.io.fields import FIELDS_FILE, require_xarray
 from metainterface.physics.cell import Design
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 from metainterface.sweep.folders import request_hash, warn_adhesive, write_result
 from metainterface.validation.batched import solve_batched
 from metainterface.validation.bem import (

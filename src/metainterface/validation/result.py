@@ -14,7 +14,8 @@ from metainterface import _checks
 from metainterface._names import DEFAULT_ENGINE
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
-from metainterface.physics.models import ForwardModel, ModelCurve, models_at
+from metainterface.physics.models import ForwardModel, ModelCurve
+from metainterface.physics.registry import models_at
 from metainterface.validation.heightmap import HeightMap
 
 

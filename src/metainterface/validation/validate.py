@@ -27,7 +27,8 @@ from metainterface import _checks
 from metainterface._names import DEFAULT_ENGINE
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
-from metainterface.physics.models import ForwardModel, ModelCurve, get_model
+from metainterface.physics.models import ForwardModel, ModelCurve
+from metainterface.physics.registry import get_model
 from metainterface.physics.sneddon import shape_constant
 from metainterface.validation.bem import (
     MAX_ITER,

@@ -26,7 +26,8 @@ from metainterface._names import DEFAULT_ENGINE, ENGINE_NAMES
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings, Design
-from metainterface.physics.models import MODELS, ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import MODELS, get_model
 
 #: Grid points per lattice cell side of the default check grid: M = 128 n (384 for N = 9).
 #: Coarser grids read the area high by themselves (the bilinear design at 192^2: about +1.2 %

@@ -51,7 +51,8 @@ from metainterface.inverse.params import DTYPE, FULL, Parameterisation
 from metainterface.inverse.refine import RefineSettings, polish
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings, Design
-from metainterface.physics.models import ForwardModel, get_model
+from metainterface.physics.models import ForwardModel
+from metainterface.physics.registry import get_model
 from metainterface.verify.check import BemCheck, Verify, bem_check
 
 #: The correction stops once the BEM error is this low (0.1 %): about the BEM's own accuracy
