@@ -9,7 +9,10 @@ the adhesive network's where weights/surrogate_adhesive.pt is there, scored with
 adhesive model) and with it. No BEM check (verify=False).
 
     PYTHONPATH=src python benchmarks/bench_adhesive_design.py [--targets 8]
-        [--models adhesive plain]
+        [--models adhesive plain] [--alone MODEL_FILE [--hedge 4]]
+
+``--alone FILE``: that network alone, zero-shot (no refinement, no fallback), ``--hedge`` its
+hedges (design's default 8).
 """
 
 from __future__ import annotations
@@ -44,12 +47,21 @@ def main() -> None:
     parser.add_argument(
         "--models", nargs="+", choices=["adhesive", "plain"], default=["adhesive", "plain"]
     )
+    parser.add_argument("--alone", metavar="MODEL_FILE", help="this network alone, zero-shot")
+    parser.add_argument("--hedge", type=int, help="with --alone: its hedges")
     args = parser.parse_args()
+    if args.alone:
+        hedge = {} if args.hedge is None else {"hedge": args.hedge}
+        efforts = {
+            False: mi.Effort(seed=0, refine=False, fallback=0, surrogate=args.alone, **hedge)
+        }
+    else:
+        efforts = {refine: mi.Effort(refine=refine, seed=0) for refine in (False, True)}
     s = CellSettings()
     rows = {}
     models = {"adhesive": mi.Independent(adhesion=W), "plain": mi.Independent()}
     for label, model in ((k, models[k]) for k in args.models):
-        for refine in (False, True):
+        for refine, effort in efforts.items():
             errs, secs = [], []
             for k in range(args.targets):
                 rng = np.random.default_rng(100 + k)
@@ -60,9 +72,7 @@ def main() -> None:
                 start = time.perf_counter()
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    r = mi.design(
-                        t, model=model, verify=False, effort=mi.Effort(refine=refine, seed=0)
-                    )
+                    r = mi.design(t, model=model, verify=False, effort=effort)
                 secs.append(time.perf_counter() - start)
                 errs.append(r.error)
             key = f"{label:8s} {'refined' if refine else 'zero-shot'}"

@@ -2,16 +2,19 @@
 curve alone? Both are the shipped friction-law network fine-tuned the same way on the same
 adhesive targets (``metainterface.surrogate.adhesive``), in the same time budget; then
 their zero-shot errors on adhesive targets made from the test cells, beside the shipped
-networks' and the floor of the true cells (the targets' own resolution).
+networks' and the floor of the true cells (the targets' own resolution). The variants: w
+as an input or not, and the training loss's snap-in window (``TrainConfig.snap_window``),
+held or falling to 0 over the run.
 
     python benchmarks/bench_adhesive_surrogate.py --out RUNS [--dataset ds100k.npz]
         [--samples 100000] [--device cuda] [--budget 240] [--batch-size 1024] [--lr 7e-4]
-        [--variants input curve] [--max-epochs 60] [--evaluate-only] [--eval-cells 2000]
+        [--variants input curve window2 window5 anneal5] [--max-epochs 60]
+        [--physics-steps 256] [--evaluate-only] [--eval-cells 2000]
 
-Training: each variant in its own process, both at once (on a GPU they share it: the steps
+Training: each variant in its own process, all at once (on a GPU they share it: the steps
 are launch-bound); one probe epoch sets how many epochs fit ``--budget`` seconds (at most
 --max-epochs), then the run starts again from the friction-law network with the cosine
-schedule over those epochs. RUNS/{input,curve}/model.pt are the networks.
+schedule over those epochs. RUNS/<variant>/model.pt are the networks.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from metainterface.data import load_dataset
 from metainterface.surrogate.adhesive import AdhesiveTargets, adhesive_error, adhesive_split
 from metainterface.surrogate.build import train_surrogate
 from metainterface.surrogate.checkpoint import (
+    default_adhesive_model_path,
     default_laws_model_path,
     default_model_path,
     load_model,
@@ -38,17 +42,28 @@ from metainterface.surrogate.checkpoint import (
 from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
 
-VARIANTS = {"input": True, "curve": False}
+#: name -> (w as an input, the loss's snap-in window, whether it falls to 0 over the run)
+VARIANTS = {
+    "input": (True, 0.0, False),
+    "curve": (False, 0.0, False),
+    "window2": (True, 0.02, False),
+    "window5": (True, 0.05, False),
+    "anneal5": (True, 0.05, True),
+}
+FIELDS = ("alpha_hat", "stiffness_hat", "p_star_max", "alpha_max")
 #: Seed of the evaluation targets (apart from training's 0 and 1).
 EVAL_SEED = 2002
 
 
-def config(args, adhesion_input: bool, epochs: int) -> TrainConfig:
+def config(args, name: str, epochs: int) -> TrainConfig:
+    adhesion_input, window, falls = VARIANTS[name]
     return TrainConfig.adhesive(
         epochs=epochs,
         batch_size=args.batch_size,
         lr=args.lr,
         adhesion_input=adhesion_input,
+        snap_window=window,
+        snap_window_epochs=epochs if falls else 0,
         lambda_start=args.lambda_start,
         curriculum_epochs=min(args.curriculum_epochs, epochs),
         physics_steps=args.physics_steps,
@@ -62,7 +77,7 @@ def train_one(args, name: str) -> None:
     probe = train_surrogate(
         args.dataset,
         out / f"probe-{name}",
-        config(args, VARIANTS[name], 1),
+        config(args, name, 1),
         progress=False,
         device=args.device,
     )
@@ -76,7 +91,7 @@ def train_one(args, name: str) -> None:
     r = train_surrogate(
         args.dataset,
         out / name,
-        config(args, VARIANTS[name], epochs),
+        config(args, name, epochs),
         progress=False,
         device=args.device,
     )
@@ -94,24 +109,26 @@ def evaluate(args) -> None:
     keep = torch.arange(min(args.eval_cells, len(test)))
     test = type(test)(
         test.features[keep],
-        type(test.targets)(
-            *(
-                getattr(test.targets, f)[keep]
-                for f in ("alpha_hat", "stiffness_hat", "p_star_max", "alpha_max")
-            )
-        ),
+        type(test.targets)(*(getattr(test.targets, f)[keep] for f in FIELDS)),
         test.gamma[keep],
         test.h[keep],
         test.category[keep.numpy()],
     )
-    split = adhesive_split(test, s, EVAL_SEED, adhesion_input=True, spec=AdhesiveTargets(copies=1))
+    dev = torch.device(
+        "cuda" if args.device in ("auto", "cuda") and torch.cuda.is_available() else "cpu"
+    )
+    split = adhesive_split(
+        test, s, EVAL_SEED, adhesion_input=True, spec=AdhesiveTargets(copies=1), device=dev
+    )
     idx = torch.arange(len(split))
     feats, targets, g, h = split.rows(idx)
+    feats, g, h, w = feats.to(dev), g.to(dev), h.to(dev), split.adhesion.to(dev)
+    targets = type(targets)(*(getattr(targets, f).to(dev) for f in FIELDS))
     cats = split.category
     rows = {}
 
     def record(name: str, err: torch.Tensor) -> None:
-        e = err.numpy()
+        e = err.cpu().numpy()
         rows[name] = {
             str(c): (float(np.median(e[cats == c])), float(np.percentile(e[cats == c], 90)))
             for c in sorted(set(cats))
@@ -126,11 +143,12 @@ def evaluate(args) -> None:
     with torch.no_grad():
         record(
             "true cells (the targets' own resolution)",
-            adhesive_error(g.double(), h.double(), targets, s, split.adhesion, n_delta=512),
+            adhesive_error(g.double(), h.double(), targets, s, w, n_delta=512),
         )
         nets = {
             "shipped surrogate": default_model_path(),
             "shipped friction-law network": default_laws_model_path(),
+            "shipped adhesive network": default_adhesive_model_path(),
         }
         for name in VARIANTS:
             path = Path(args.out) / name / "model.pt"
@@ -138,11 +156,12 @@ def evaluate(args) -> None:
                 nets[f"adhesive, {name}"] = path
         for name, path in nets.items():
             net, _, _ = load_model(path)
+            net = net.to(dev)
             x = feats if net.adhesion_input else feats[:, :-1]
             gp, hp = net.design(x, s)
             record(
                 name,
-                adhesive_error(gp.double(), hp.double(), targets, s, split.adhesion, n_delta=512),
+                adhesive_error(gp.double(), hp.double(), targets, s, w, n_delta=512),
             )
     header = ["network", *next(iter(rows.values())).keys()]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" + "---:|" * (len(header) - 1)]
@@ -173,7 +192,7 @@ def main() -> None:
         "--lambda-start", type=float, default=0.0, help="the parameter anchor (cut targets' cells)"
     )
     ap.add_argument("--curriculum-epochs", type=int, default=0)
-    ap.add_argument("--physics-steps", type=int, default=64)
+    ap.add_argument("--physics-steps", type=int, default=256)
     ap.add_argument("--evaluate-only", action="store_true")
     ap.add_argument("--variants", nargs="+", choices=list(VARIANTS), default=list(VARIANTS))
     ap.add_argument("--train", choices=list(VARIANTS), help=argparse.SUPPRESS)

@@ -51,7 +51,8 @@ fi
 if [ "$budget" -gt 0 ]; then
   runs=/tmp/adhesive_runs
   OMP_NUM_THREADS=2 timeout $((budget * 2 + 150)) python3 benchmarks/bench_adhesive_surrogate.py \
-    --out $runs --device cuda --budget "$budget" --eval-cells 2000 >"$out/adhesive.log" 2>&1
-  for v in input curve; do cp "$runs/$v/model.pt" "$out/adhesive_$v.pt" 2>/dev/null; done
+    --out $runs --device cuda --budget "$budget" --eval-cells 2000 --variants window2 input \
+    >"$out/adhesive.log" 2>&1
+  for v in window2 input; do cp "$runs/$v/model.pt" "$out/adhesive_$v.pt" 2>/dev/null; done
 fi
 echo "done after ${SECONDS} s"

@@ -15,7 +15,7 @@ from scipy import integrate, optimize
 
 import metainterface as mi
 from metainterface.errors import MetainterfaceError
-from metainterface.physics.adhesion import sweep_adhesive
+from metainterface.physics.adhesion import sweep_adhesive, touch_grid
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.jkr import (
     detach_radius,
@@ -234,6 +234,37 @@ def test_load_control_jumps():
     ref = _reference_load_control(heights, W, loads * s.nominal_area)
     got = np.interp(loads, p, alpha) * s.nominal_area / math.pi
     np.testing.assert_allclose(got, ref, rtol=1e-5)
+
+
+def test_on_the_touch_grid_a_snap_in_is_at_the_jkr_force_at_the_touch():
+    """Two spheres touch at 0 and two at h2 = delta(a1): the later pair snaps in at the load
+    2 F(a1) of the first pair (JKR), however coarse the uniform samples, and that load
+    follows h2 (its derivative, 2 F'(a1) / delta'(a1) / A_nom); a uniform grid reads the
+    last sample's force instead."""
+    s = CellSettings(n_asperities=4)
+    a1 = 0.1
+    h2 = sphere_delta(a1, W, 1.0)  # 0.00486: between the samples of a 9-sample grid
+    heights = t([[0.0, 0.0, h2, h2]]).requires_grad_()
+    gamma = t([[2.0] * 4])
+    closed = 2 * sphere_force(a1, W, 1.0) / s.nominal_area
+    slope = (
+        2
+        * (4 * a1**2 - 3 * math.sqrt(2 * math.pi * W * a1))
+        / (2 * a1 - 0.5 * math.sqrt(2 * math.pi * W / a1))
+    )
+    for n_delta in (9, 33):
+        grid = touch_grid(heights, s, n_delta)
+        assert grid.shape == (1, n_delta + 4) and bool((grid.diff(dim=-1) >= 0).all())
+        sw, _ = sweep_adhesive(gamma, heights, s, W, delta=grid)
+        p = sw.p_star[0]
+        plateau = int(torch.nonzero((p[1:] == p[:-1]) & (p[1:] > 0))[0, 0])
+        assert float(p[plateau]) == pytest.approx(closed, rel=1e-7)
+        (grad,) = torch.autograd.grad(p[plateau], heights)
+        assert float(grad[0, 2:].sum()) == pytest.approx(slope / s.nominal_area, rel=1e-6)
+    # the least load with the later pair in contact: the uniform grid is far off
+    uniform, per = sweep_adhesive(gamma, heights.detach(), s, W, n_delta=9)
+    first = float(uniform.p_star[0][per[0, :, 2] > 0].min())
+    assert abs(first - closed) > 0.05 * closed
 
 
 def test_models_and_errors():

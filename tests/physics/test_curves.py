@@ -8,6 +8,7 @@ import torch
 
 from metainterface.errors import MetainterfaceError
 from metainterface.physics import CellSettings, curve, interp, kappa, sweep
+from metainterface.physics.metrics import window_mean
 
 F64 = torch.float64
 S = CellSettings()
@@ -165,6 +166,33 @@ def test_interp_holds_ends_and_duplicate_knots():
     fp = torch.tensor([[5.0, 0.0, 1.0, 4.0]], dtype=F64)
     xq = torch.tensor([[-1.0, 0.0, 0.5, 1.5, 3.0]], dtype=F64)
     np.testing.assert_allclose(interp(xq, xp, fp), [[5.0, 5.0, 0.5, 2.5, 4.0]])
+
+
+def test_window_mean_is_the_box_average_of_the_curve():
+    # a line is its own box average inside; a step at x0 averages to the window's share
+    # beyond it, a ramp of width 2 half; ends held; half -> 0 is the plain read
+    xp = torch.tensor([[0.0, 1.0, 1.0, 3.0]], dtype=F64)
+    fp = torch.tensor([[0.0, 1.0, 3.0, 5.0]], dtype=F64)  # slope 1, a jump of 2 at 1, slope 1
+    xq = torch.tensor([[0.5, 0.95, 1.0, 1.1, 2.0, 3.0, -1.0]], dtype=F64)
+    half = 0.2
+    line = xq + 2.0 * ((xq + half - 1.0) / (2 * half)).clamp(0, 1)
+    # held at the ends: [2.8, 3.2] has 0.2 at 5 beyond 3; [-1.2, -0.8] is all at 0
+    expected = line.clone()
+    expected[0, 5] = (0.2 * (4.8 + 5.0) / 2 + 0.2 * 5.0) / 0.4
+    expected[0, 6] = 0.0
+    np.testing.assert_allclose(window_mean(xq, half, xp, fp), expected, rtol=1e-12, atol=1e-15)
+    off_step = [0, 1, 3, 4, 5]  # on the step itself the box average is the step's midpoint
+    np.testing.assert_allclose(
+        window_mean(xq, 1e-9, xp, fp)[:, off_step], interp(xq, xp, fp)[:, off_step], rtol=1e-7
+    )
+    # the read moves with the step: shifting the curve by s changes its box average by
+    # -(f(x + half) - f(x - half)) / (2 half) ds, the step's jump of 2 included
+    knots = xp.clone().requires_grad_()
+    at = torch.tensor([[1.05]], dtype=F64)
+    (grad,) = torch.autograd.grad(window_mean(at, half, knots, fp).sum(), knots)
+    ends = interp(at + torch.tensor([[-half, half]], dtype=F64), xp, fp)[0]
+    expected_shift = -float(ends[1] - ends[0]) / (2 * half)  # -(3.25 - 0.85) / 0.4
+    assert float(grad.sum()) == pytest.approx(expected_shift, rel=1e-12)
 
 
 @pytest.mark.parametrize(

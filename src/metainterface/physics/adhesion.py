@@ -224,6 +224,20 @@ def sweep_adhesive(
     ), per_j
 
 
+def touch_grid(h: Tensor, settings: CellSettings, n_delta: int) -> Tensor:
+    """(B, n_delta + N) ascending approaches [length]: ``n_delta`` uniform ones on
+    [0, Delta_max] and one just short of each asperity's touch (its anchored height, at most
+    Delta_max), for (B, N) heights h.
+
+    On such a grid the load where an asperity snaps in (the running maximum just before its
+    touch) is the cell's force at the touch itself, differentiable in the height; on a
+    uniform grid it is the last sample's, which a height moves only in steps.
+    """
+    uniform = delta_grid(settings, n_delta, dtype=h.dtype, device=h.device)
+    touch = (anchor(h) * (1.0 - 1e-9)).clamp_max(settings.delta_max)
+    return torch.sort(torch.cat([uniform.expand(h.shape[0], -1), touch], -1), dim=-1).values
+
+
 def touch_loads(
     gamma: Tensor,
     h: Tensor,

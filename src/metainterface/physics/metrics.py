@@ -41,6 +41,34 @@ def interp_weights(xq: Tensor, xp: Tensor) -> tuple[Tensor, Tensor, Tensor, Tens
     return idx, torch.where(has_width, ratio.clamp(0, 1), 0.0), width, ratio
 
 
+def window_mean(xq: Tensor, half: Tensor | float, xp: Tensor, fp: Tensor) -> Tensor:
+    """The mean of :func:`interp`'s curve over [xq - half, xq + half]: a box-smoothed read.
+
+    xq: (B, Q) query points; half: the window's half-width, > 0 (a number, or (B,) / (B, Q));
+    xp: (B, K) non-decreasing knots, fp: (B, K) values. Returns (B, Q). A step in fp
+    (repeated knots) becomes a ramp of width 2 half, so the read is differentiable in where
+    the step is (a plain read sees only the values either side of it). Exact: the
+    difference of the piecewise-linear curve's integral, held constant beyond the ends.
+    """
+    half_t = torch.as_tensor(half, dtype=xq.dtype, device=xq.device)
+    if half_t.dim() == 1:
+        half_t = half_t[:, None]
+    width = xp[..., 1:] - xp[..., :-1]
+    # the integral from xp[0] to each knot, (B, K), by trapezoids (0 for a repeated knot)
+    area = torch.cumsum(0.5 * width * (fp[..., 1:] + fp[..., :-1]), dim=-1)
+    area = torch.cat([torch.zeros_like(area[..., :1]), area], dim=-1)
+
+    def integral(x: Tensor) -> Tensor:
+        idx, w, span, _ = interp_weights(x, xp)
+        f0, f1 = fp.gather(-1, idx - 1), fp.gather(-1, idx)
+        inside = area.gather(-1, idx - 1) + span * w * (f0 + 0.5 * w * (f1 - f0))
+        below = torch.clamp_max(x - xp[..., :1], 0.0) * fp[..., :1]
+        above = torch.clamp_min(x - xp[..., -1:], 0.0) * fp[..., -1:]
+        return inside + below + above
+
+    return (integral(xq + half_t) - integral(xq - half_t)) / (2.0 * half_t)
+
+
 def relative_l2(values: Tensor, reference: Tensor) -> Tensor:
     """||values - reference||_2 / ||reference||_2 along the last axis: (B, M) -> (B,).
 

@@ -32,11 +32,11 @@ from torch import Tensor
 from tqdm.auto import tqdm
 
 from metainterface.errors import MetainterfaceError
-from metainterface.physics.adhesion import sweep_adhesive
+from metainterface.physics.adhesion import sweep_adhesive, touch_grid
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import features_from_normalised, normalised_from_points
 from metainterface.physics.jkr import ADHESION_LIMIT
-from metainterface.physics.metrics import interp, relative_l2
+from metainterface.physics.metrics import interp, relative_l2, window_mean
 from metainterface.surrogate.data import Split
 from metainterface.surrogate.laws import ROWS, check_counts
 from metainterface.surrogate.loss import CurveTargets
@@ -152,16 +152,28 @@ def adhesive_error(
     settings: CellSettings,
     adhesion: Tensor,
     n_delta: int = 64,
+    window: float = 0.0,
 ) -> Tensor:
     """(B,) relative L2 error of (B, N) designs' adhesive loading curves at the target's
     loads (its n_steps uniform pressures up to P*_max), each design at its own w / (E* R)
-    ``adhesion`` (B,). The curve is an ``n_delta`` sweep of [0, Delta_max] in float64,
-    interpolated in the load (held beyond the design's reach); differentiable."""
+    ``adhesion`` (B,); differentiable.
+
+    The curve is an ``n_delta`` sweep of [0, Delta_max] in float64 with, besides, an approach
+    just short of each asperity's touch: the load where it snaps in is then the force at its
+    touch, exact and differentiable in its height (between uniform samples it would be the
+    last sample's, blind to it). It is read in the load, held beyond the design's reach;
+    ``window`` > 0 reads the mean over loads within +-window P*_max instead (a snap-in is then
+    a ramp whose place the gradient sees: the training loss; 0 is the error itself)."""
     g, hh = gamma.double(), h.double()
     n = target.alpha_hat.shape[-1]
     grid = torch.linspace(0, 1, n, dtype=g.dtype, device=g.device)
-    p = grid[None] * target.p_star_max.to(g.dtype)[:, None]
-    sw, _ = sweep_adhesive(g, hh, settings, adhesion.to(g.dtype), n_delta=n_delta)
-    alpha = interp(p, sw.p_star, sw.alpha)
+    top = target.p_star_max.to(g.dtype)
+    p = grid[None] * top[:, None]
+    delta = touch_grid(hh, settings, n_delta)
+    sw, _ = sweep_adhesive(g, hh, settings, adhesion.to(g.dtype), delta=delta)
+    if window > 0:
+        alpha = window_mean(p, window * top, sw.p_star, sw.alpha)
+    else:
+        alpha = interp(p, sw.p_star, sw.alpha)
     reference = (target.alpha_hat * target.alpha_max[:, None]).to(g.dtype)
     return relative_l2(alpha, reference).to(gamma.dtype)

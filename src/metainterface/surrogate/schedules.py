@@ -3,7 +3,8 @@
 Contact regularisation: the softplus steepness kappa_s grows exponentially from kappa_start
 to kappa_end over the first ``kappa_fraction`` of the epochs, then stays at kappa_end.
 Curriculum: the parameter-anchor weight lambda falls linearly from lambda_start to 0 over the
-first ``curriculum_epochs`` epochs.
+first ``curriculum_epochs`` epochs. Adhesive targets: the loss's snap-in window falls
+linearly from window_start to 0 over ``window_epochs`` (0: held).
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ class Schedules:
     kappa_fraction: float = 0.25
     lambda_start: float = 1.0
     curriculum_epochs: int = 20
+    window_start: float = 0.0
+    window_epochs: int = 0
 
     def kappa(self, epoch: int) -> float:
         """Softplus steepness at 0-based ``epoch`` [1/R]."""
@@ -39,3 +42,9 @@ class Schedules:
         if self.curriculum_epochs <= 0:
             return 0.0
         return self.lambda_start * max(0.0, 1.0 - epoch / self.curriculum_epochs)
+
+    def window(self, epoch: int) -> float:
+        """The adhesive loss's snap-in window at 0-based ``epoch`` (a fraction of P*_max)."""
+        if self.window_epochs <= 0:
+            return self.window_start
+        return self.window_start * max(0.0, 1.0 - epoch / self.window_epochs)

@@ -73,9 +73,11 @@ def evaluate_loss(
     weights: LossWeights = PAPER_WEIGHTS,
     chunk: int = 4096,
     reads: str = "curves",
+    n_delta: int | None = None,
 ) -> float:
     """Mean exact-physics loss of the model on a split (no gradients, eval mode), on the
-    split's device (the model must be there too); ``reads`` as in :class:`TrainConfig`."""
+    split's device (the model must be there too); ``reads`` as in :class:`TrainConfig`;
+    ``n_delta`` the adhesive sweep's approaches (None: 64)."""
     model.eval()
     total = 0.0
     with torch.no_grad():
@@ -84,7 +86,14 @@ def evaluate_loss(
             feats, targets, _, _ = split.rows(idx)
             gamma, h = model.design(feats, settings)
             loss = batch_loss(
-                gamma, h, targets, settings, weights, reads, adhesion=split.adhesion_rows(idx)
+                gamma,
+                h,
+                targets,
+                settings,
+                weights,
+                reads,
+                n_delta=n_delta,
+                adhesion=split.adhesion_rows(idx),
             )
             total += float(loss) * len(idx)
     return total / len(split)
@@ -100,6 +109,7 @@ def batch_loss(
     smooth: float | None = None,
     n_delta: int | None = None,
     adhesion: torch.Tensor | None = None,
+    window: float = 0.0,
 ) -> torch.Tensor:
     """The training loss of predicted (B, N) designs (a scalar). Curves: the composite loss
     on the design's curve (``smooth``: the softplus steepness kappa_s, None for the exact
@@ -107,13 +117,16 @@ def batch_loss(
     :func:`~metainterface.surrogate.loss.law_error`, exact law at the target's pressures
     (a target that ends early is seen at full resolution). Adhesive: ``weights.curve``
     times the mean :func:`~metainterface.surrogate.adhesive.adhesive_error` at each
-    target's work of adhesion ``adhesion`` (B,), on an ``n_delta`` sweep."""
+    target's work of adhesion ``adhesion`` (B,), on an ``n_delta`` sweep, read over a load
+    ``window`` (a fraction of P*_max; 0 the plain read)."""
     if reads == "adhesive":
         from metainterface.surrogate.adhesive import adhesive_error
 
         if adhesion is None:
             raise MetainterfaceError("adhesive targets need their work of adhesion")
-        err = adhesive_error(gamma, h, targets, settings, adhesion, n_delta=n_delta or 64)
+        err = adhesive_error(
+            gamma, h, targets, settings, adhesion, n_delta=n_delta or 64, window=window
+        )
         return weights.curve * err.mean()
     if reads == "laws":
         return weights.curve * law_error(gamma, h, targets, settings).mean()
@@ -247,6 +260,7 @@ def train(
                 kappa,
                 config.physics_steps,
                 adhesion=train_split.adhesion_rows(order[lo : lo + config.batch_size]),
+                window=schedules.window(epoch),
             )
             if lam > 0:
                 loss = loss + lam * param_loss(gamma, h, g_t, h_t, settings)
@@ -258,7 +272,14 @@ def train(
         run_loss = float(epoch_loss)
         lr = opt.param_groups[0]["lr"]
         sched.step()
-        val = evaluate_loss(model, val_split, settings, config.weights, reads=config.reads)
+        val = evaluate_loss(
+            model,
+            val_split,
+            settings,
+            config.weights,
+            reads=config.reads,
+            n_delta=config.physics_steps if config.reads == "adhesive" else None,
+        )
         if not math.isfinite(val):
             raise MetainterfaceError(
                 f"training diverged at epoch {epoch + 1} (validation loss {val})"
