@@ -206,3 +206,28 @@ def test_design_takes_a_work_of_adhesion_with_its_scale():
     assert np.isfinite(r.error)
     with pytest.raises(MetainterfaceError, match="work_of_adhesion needs the modulus"):
         mi.design("bilinear", scale=mi.Scale(work_of_adhesion="50mJ/m2"), **quick)
+
+
+def test_the_notes_are_of_the_design_the_bem_corrected(tmp_path):
+    """A design corrected in BEM is another design: its friction at zero load and pull-off
+    force are stated for it, not for the design before the correction."""
+    path = _write(tmp_path, *_held_back_law())
+    scale = dict(shear_strength=TAU, modulus=E, radius=R, area=AREA, fit="never")
+    target = mi.Target.from_friction(path, work_of_adhesion="50mJ/m2", **scale)
+    quick = mi.Effort(refine=False, seed=0)
+    checks = mi.Verify(grid=48, loads=4, correct=True, iterations=1, restart=False, inner=None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        before = mi.design(target, verify=False, effort=quick)
+        after = mi.design(target, verify=checks, effort=quick)
+    assert after.corrections and not np.allclose(after.design.h, before.design.h)
+    gamma, h = after.design.tensors(torch.float64)
+    tiny = torch.tensor([[1e-12 * float(target.p_star_max)]], dtype=torch.float64)
+    with torch.no_grad():
+        alpha0 = float(after.model.alpha_at_loads(gamma, h, after.design.settings, tiny)[0, 0])
+    (zero,) = [n for n in after.notes if "friction at zero load" in n]
+    stated = float(zero.split("friction at zero load ")[1].split(" N")[0])
+    assert stated == pytest.approx(alpha0 * TAU * AREA, rel=2e-3)  # the note's 3 digits
+    (zero_before,) = [n for n in before.notes if "friction at zero load" in n]
+    assert zero != zero_before
+    assert "corrected in BEM" in zero and "corrected in BEM" not in zero_before

@@ -154,7 +154,16 @@ def _offset_note(result: Any, gamma: Any, h: Any, scale: float) -> tuple[str, ..
     if not np.isfinite(f_design):
         return ()
     how = ", extrapolated from its first two rows" if extrapolated(t) else ""
-    return (
+    note = (
         f"adhesion: friction at zero load {f_design:.3g} N, the law's {f_law:.3g} N{how} "
-        f"({100 * (f_design / f_law - 1):+.3g} %)",
+        f"({100 * (f_design / f_law - 1):+.3g} %)"
     )
+    before = getattr(result, "bem_before", None)
+    if before is not None and getattr(result, "bem", None) is not before:
+        # the BEM reads no state at zero load: the correction holds its difference from the
+        # model at its lowest load down to zero load, so the model's F_0 moves by it too
+        note += (
+            "; the design is corrected in BEM: its model curve is the law's moved by the "
+            "BEM's difference from the model, at zero load the one at the BEM's lowest load"
+        )
+    return (note,)

@@ -226,7 +226,6 @@ def design(
         device=dev,
     )
     results = [_public(r, limit, modulus) for r in raw]
-    results = [replace(r, notes=(*r.notes, *adhesion_notes(r))) for r in results]
     results = [_forced(r, reach.get(r.target.name)) for r in results]
     if perturb is not None:
         results = [_robust_stats(r, perturb, seed, dev) for r in results]
@@ -236,6 +235,8 @@ def design(
         results = _verify_all(
             results, checks, extra_loss, refine_settings, step, perturb, limit, modulus
         )
+    # after the BEM's correction: the notes are of the design that is returned and written
+    results = [replace(r, notes=(*r.notes, *adhesion_notes(r))) for r in results]
     if out is not None:
         out = Path(out)
         folders = [out] if single else [out / r.target.name for r in results]
