@@ -113,9 +113,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--fallback",
         type=int,
         default=50,
-        help="surrogate method: a target still missed by more than 2 %% after refinement also "
-        "gets a multistart with this many random starts, the better design kept (default 50; "
-        "0 = off)",
+        help="surrogate method: a target still missed by more than 2 %% (1 %% with adhesion) "
+        "after refinement also gets a multistart with this many random starts, the better "
+        "design kept (default 50; 0 = off)",
     )
     p.add_argument(
         "--physics",

@@ -113,8 +113,8 @@ class Effort:
         Surrogate method: extra starts refined beside the prediction (half jittered copies of
         it, half random), in [0, 10000]; 0 is the paper's pure pipeline.
     fallback : int
-        Surrogate method: a target still missed by more than 2 % also gets a multistart with
-        this many starts, the better design kept; 0 turns it off.
+        Surrogate method: a target still missed by more than 2 % (1 % with adhesion) also
+        gets a multistart with this many starts, the better design kept; 0 turns it off.
     refine : bool
         Refine the starts (False: the zero-shot prediction or the best raw start).
     seed : int

@@ -43,6 +43,13 @@ from metainterface.physics.cell import CellSettings
 from metainterface.physics.models import ForwardModel
 from metainterface.physics.registry import get_model
 
+#: The curve error above which a refined surrogate design also gets the fallback multistart.
+FALLBACK_ERROR = 0.02
+#: ... with adhesion: which asperities are in contact at zero load (a count that no gradient
+#: changes) sets an adhesive curve's start, so a design that reads the target well (1-2 %)
+#: may still sit at the wrong count; the multistart's starts try others.
+ADHESIVE_FALLBACK_ERROR = 0.01
+
 #: Design methods and the parameterisation each refines: the surrogate's prediction and the
 #: multistart in the full space, the Hertz-only baseline with gamma fixed at 2.
 METHODS: dict[str, Parameterisation] = dict(zip(METHOD_NAMES, (FULL, FULL, HERTZ), strict=True))
@@ -66,7 +73,7 @@ def design(
     model: str | ForwardModel | None = None,
     hedge: int = 0,
     fallback: int = 0,
-    fallback_error: float = 0.02,
+    fallback_error: float | None = None,
     hedge_error: float = HEDGE_ERROR,
     perturb: Perturbation | None = None,
     z_step: float | None = None,
@@ -85,8 +92,9 @@ def design(
     every target needs them (a scale search's candidates).
 
     ``fallback`` (surrogate method only): a target whose refined design still misses it by
-    more than ``fallback_error`` (relative curve error) is far from anything the surrogate
-    learned; it also gets a ``fallback``-start multistart (same seed, settings and
+    more than ``fallback_error`` (relative curve error; None: ``FALLBACK_ERROR``, or
+    ``ADHESIVE_FALLBACK_ERROR`` for a model with adhesion) is far from anything the
+    surrogate learned; it also gets a ``fallback``-start multistart (same seed, settings and
     refinement) and keeps the better design (``DesignResult.fallback`` says which). Targets
     the surrogate meets cost nothing extra. 0 (the default) is the paper's pipeline.
 
@@ -115,6 +123,8 @@ def design(
     results are numpy.
     """
     model = get_model(model)
+    if fallback_error is None:
+        fallback_error = ADHESIVE_FALLBACK_ERROR if model.adhesion else FALLBACK_ERROR
     dev = resolve_device(device)
     common = dict(
         refine_designs=refine_designs,
