@@ -7,9 +7,11 @@ mJ/m^2), designed by the default path without the BEM check. The curve error wei
 zero-load row as one point of many; the design's note states F_0 against the law's.
 
     PYTHONPATH=src python benchmarks/bench_offset_f0.py [--seeds 11 12 13] [--range 11 30]
+        [--zero-shot]
 
 Ends with the median and largest curve error and |F_0 error| over the laws (``--range A B``:
-the seeds A..B).
+the seeds A..B). ``--zero-shot``: the design before its refinement, as
+``bench_friction_laws.py`` measures it (``Effort(refine=False, hedge=0, fallback=0)``).
 """
 
 from __future__ import annotations
@@ -32,7 +34,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=[11, 12, 13])
     ap.add_argument("--range", type=int, nargs=2, default=None, metavar=("FIRST", "LAST"))
+    ap.add_argument("--zero-shot", action="store_true", help="the design before refinement")
     args = ap.parse_args()
+    quick = {"refine": False, "hedge": 0, "fallback": 0} if args.zero_shot else {}
+    effort = mi.Effort(seed=0, **quick)
     if args.range:
         args.seeds = list(range(args.range[0], args.range[1] + 1))
     errors, f0_errors = [], []
@@ -61,7 +66,7 @@ def main() -> None:
             start = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                r = mi.design(t, verify=False, effort=mi.Effort(seed=0))
+                r = mi.design(t, verify=False, effort=effort)
             note = next((n for n in r.notes if "friction at zero load" in n), "-")
             errors.append(100 * r.error)
             share = re.search(r"\(([+-][\d.e+-]+) %\)$", note)  # the note's "(+25.3 %)"
