@@ -193,9 +193,17 @@ def levelled(scan: Scan, tilt: np.ndarray) -> np.ndarray:
     return scan.heights - (tilt[0] * x + tilt[1] * y)
 
 
-def fit_asperities(scan: Scan, design: Design, lattice: Lattice, tilt: np.ndarray) -> AsperityFits:
+def fit_asperities(
+    scan: Scan,
+    design: Design,
+    lattice: Lattice,
+    tilt: np.ndarray,
+    *,
+    gamma_start: float | None = None,
+) -> AsperityFits:
     """Stage 2 (module docstring): every asperity whose tip is in the scan and whose disc is
-    at least ``MIN_COVER`` measured."""
+    at least ``MIN_COVER`` measured. gamma_start: one exponent to start every fit from
+    (before the lattice's orientation is known); None: the design's at each position."""
     s = design.settings
     n = s.n_side
     p = lattice.design_pitch
@@ -257,13 +265,11 @@ def fit_asperities(scan: Scan, design: Design, lattice: Lattice, tilt: np.ndarra
     m = torch.as_tensor(mask)
     zsc = s.delta_max
     top = np.array([np.nanmax(np.where(mask[i], pad[2, i], np.nan)) for i in range(b)])
-    z0 = torch.tensor(top / zsc, requires_grad=True)
-    torch.tensor(design.gamma[kinds].astype(np.float64), requires_grad=True)
-    sh = torch.zeros((b, 2), dtype=torch.float64, requires_grad=True)
+    g_start = design.gamma[kinds] if gamma_start is None else np.full(b, gamma_start)
     x0 = torch.stack(
         [
             torch.as_tensor(top / zsc),
-            torch.as_tensor(design.gamma[kinds].astype(np.float64)),
+            torch.as_tensor(g_start.astype(np.float64)),
             torch.zeros(b, dtype=torch.float64),
             torch.zeros(b, dtype=torch.float64),
         ],

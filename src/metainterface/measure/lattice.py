@@ -76,13 +76,25 @@ class Lattice:
         }
 
 
-def plane_removed(scan: Scan) -> np.ndarray:
-    """The scan's heights less their least-squares plane (only to find tips; biased by the
-    pattern, so never the levelling itself)."""
+def _plane(scan: Scan) -> np.ndarray:
     x, y = np.meshgrid(*scan.coords())
     ok = scan.valid
     a = np.stack([x[ok], y[ok], np.ones(ok.sum())], axis=1)
     coef, *_ = np.linalg.lstsq(a, scan.heights[ok], rcond=None)
+    return coef
+
+
+def plane_slopes(scan: Scan) -> np.ndarray:
+    """(2,) slopes (dz/dx, dz/dy) of the scan's least-squares plane: a first levelling only
+    (biased by the pattern; the lattice fit levels it properly)."""
+    return _plane(scan)[:2]
+
+
+def plane_removed(scan: Scan) -> np.ndarray:
+    """The scan's heights less their least-squares plane (only to find tips; biased by the
+    pattern, so never the levelling itself)."""
+    x, y = np.meshgrid(*scan.coords())
+    coef = _plane(scan)
     return scan.heights - (coef[0] * x + coef[1] * y + coef[2])
 
 
@@ -95,7 +107,10 @@ def find_tips(scan: Scan, pitch: float) -> np.ndarray:
     low = np.nanmin(z)
     filled = np.where(np.isfinite(z), z, low)
     px = pitch / min(scan.dx, scan.dy)
-    sigma = max(1.0, px / 64.0)  # noise off, the tips kept
+    # a twelfth of a pitch: the noise off, and a flat or terraced top's highest point at its
+    # centre (a flat top's maximum pixel is anywhere on it); a neighbour a pitch away is
+    # six sigmas off and does not move it
+    sigma = max(1.0, px / 12.0)
     smooth = ndimage.gaussian_filter(filled, sigma, mode="nearest")
     size = max(3, int(0.5 * px) | 1)
     peak = (smooth == ndimage.maximum_filter(smooth, size=size, mode="nearest")) & scan.valid
@@ -124,13 +139,10 @@ def _spacing(tips: np.ndarray, design_pitch: float) -> tuple[float, float] | Non
     return theta, float(np.median(length[near]))
 
 
-def first_lattice(
-    scan: Scan, design: Design, design_pitch: float
-) -> tuple[Lattice, np.ndarray, float]:
-    """The lattice from the tips and the design (see the module docstring), the tilt (2,)
-    (dz/dx, dz/dy) fitted with it, and the share of the scan's variance the designed map
-    explains there. Raises MetainterfaceError if the
-    scan shows no lattice of this design's pitch, or one that the design does not explain."""
+def lattice_geometry(scan: Scan, design_pitch: float) -> tuple[np.ndarray, float, float]:
+    """The scan's tips (T, 2), the lattice's rotation theta (modulo 90 degrees: a square
+    lattice looks the same turned by a quarter) [rad] and its pitch [R]. Raises
+    MetainterfaceError if the scan shows no lattice of this pitch."""
     tips = find_tips(scan, design_pitch)
     if len(tips) == 0:
         raise MetainterfaceError(
@@ -145,31 +157,29 @@ def first_lattice(
                 f"{design_pitch * scan.radius_m * 1e6:.4g} um apart (within "
                 f"{PITCH_TOLERANCE:.0%})"
             )
-        theta, pitch = 0.0, design_pitch
-    else:
-        theta, pitch = found
+        return tips, 0.0, design_pitch
+    theta, pitch = found
+    return tips, theta, pitch
+
+
+def lattice_at(
+    tips: np.ndarray, theta: float, pitch: float, design_pitch: float, shift: tuple[int, int]
+) -> Lattice:
+    """The lattice turned by ``theta`` whose unit cell's corner is ``shift`` = (columns,
+    rows) lattice squares from the one the tips put nearest the scan's origin: each of the
+    n^2 shifts puts another asperity of the design on a given tip."""
     c, s = math.cos(theta), math.sin(theta)
     w = np.stack([c * tips[:, 0] + s * tips[:, 1], -s * tips[:, 0] + c * tips[:, 1]], 1) / pitch
     frac = np.angle(np.exp(2j * np.pi * (w - 0.5)).mean(axis=0)) / (2 * np.pi)  # (2,)
-    n = design.settings.n_side
-    best: tuple[float, Lattice, np.ndarray] | None = None
-    x, y, z = _sample(scan)
-    for di in range(n):
-        for dj in range(n):
-            o = pitch * (frac + np.array([dj, di]) - n)  # rotated frame
-            origin = np.array([c * o[0] - s * o[1], s * o[0] + c * o[1]])
-            lat = Lattice(origin=origin, theta=theta, pitch=pitch, design_pitch=design_pitch)
-            explained, tilt = _explained(lat, design, x, y, z)
-            if best is None or explained > best[0]:
-                best = (explained, lat, tilt)
-    assert best is not None
-    explained, lat, tilt = best
-    if explained < MIN_EXPLAINED:
-        raise MetainterfaceError(
-            "scan does not show this design's lattice: the designed map explains "
-            f"{explained:.0%} of its height variance (at least {MIN_EXPLAINED:.0%} expected)"
-        )
-    return lat, tilt, explained
+    o = pitch * (frac + np.asarray(shift, dtype=np.float64))  # in the turned frame
+    origin = np.array([c * o[0] - s * o[1], s * o[0] + c * o[1]])
+    return Lattice(origin=origin, theta=theta, pitch=pitch, design_pitch=design_pitch)
+
+
+def explained(lat: Lattice, design: Design, scan: Scan) -> tuple[float, np.ndarray]:
+    """Share of the scan's height variance that the designed map (scaled) and a plane
+    explain on ``lat``, and that plane's slopes (2,) (dz/dx, dz/dy)."""
+    return _explained(lat, design, *_sample(scan))
 
 
 def _sample(scan: Scan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -15,7 +15,8 @@ import numpy as np
 
 from metainterface.errors import MetainterfaceError
 from metainterface.measure.fit import AsperityFits, fit_asperities, fit_lattice
-from metainterface.measure.lattice import Lattice, first_lattice
+from metainterface.measure.lattice import Lattice
+from metainterface.measure.orient import Orientation, orient
 from metainterface.measure.scan import Scan
 from metainterface.physics.cell import Design
 
@@ -27,14 +28,18 @@ TIED_ROUNDS = 8
 class Registration:
     """Where the design lies in the scan and how its asperities came out.
 
-    lattice, tilt (2,) dz/dx, dz/dy; explained: share of the scan's height variance the
-    designed map explained at the first registration. fits: every fitted asperity instance.
+    scan: the scan as registered (mirrored where the file's y axis was reversed);
+    orientation: which way round the part lies (``measure.orient.Orientation``); lattice,
+    tilt (2,) dz/dx, dz/dy; explained: share of the scan's height variance the designed
+    map explained at the first registration. fits: every fitted asperity instance.
     Per asperity k of the design, (N,) each: gamma, h (made exponent, made height [R],
     means over the cells; the design's own where ``seen`` is 0), seen (instances fitted),
     gamma_spread, h_spread (standard deviation between cells), shift (N, 2) [R], tip_radius
     and tip_radius_design [R] (means; inf where flat).
     """
 
+    scan: Scan
+    orientation: Orientation
     lattice: Lattice
     tilt: np.ndarray
     explained: float
@@ -66,7 +71,7 @@ def check_size(scan: Scan, design: Design) -> float:
 def register(scan: Scan, design: Design) -> Registration:
     """Register ``scan`` (lengths in R) to ``design``; see the module docstring."""
     pitch = check_size(scan, design)
-    lattice, tilt, explained = first_lattice(scan, design, pitch)
+    scan, lattice, tilt, explained, orientation = orient(scan, design, pitch)
     fits = fit_asperities(scan, design, lattice, tilt)
     n = design.n_asperities
     if fits.kind.size:
@@ -83,7 +88,7 @@ def register(scan: Scan, design: Design) -> Registration:
         raise MetainterfaceError(
             "scan does not show this design's lattice: no asperity is seen whole enough to fit"
         )
-    return _summarise(design, lattice, tilt, explained, fits)
+    return _summarise(scan, orientation, design, lattice, tilt, explained, fits)
 
 
 def _repeated(fits: AsperityFits) -> bool:
@@ -112,7 +117,13 @@ def _by_kind(
 
 
 def _summarise(
-    design: Design, lattice: Lattice, tilt: np.ndarray, explained: float, fits: AsperityFits
+    scan: Scan,
+    orientation: Orientation,
+    design: Design,
+    lattice: Lattice,
+    tilt: np.ndarray,
+    explained: float,
+    fits: AsperityFits,
 ) -> Registration:
     n = design.n_asperities
     z0, gamma, seen = _by_kind(fits, n, design)
@@ -138,6 +149,8 @@ def _summarise(
 
     shift = np.stack([mean(fits.shift[:, 0], 0.0), mean(fits.shift[:, 1], 0.0)], axis=1)
     return Registration(
+        scan=scan,
+        orientation=orientation,
         lattice=lattice,
         tilt=np.asarray(tilt, dtype=np.float64),
         explained=explained,

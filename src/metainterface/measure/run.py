@@ -86,6 +86,7 @@ def measure(
 
         grid = check_grid(grid, design.settings)
     reg = register(s, design)
+    s = reg.scan  # as registered: mirrored where the file's y axis runs the other way
     with contextlib.ExitStack() as stack:
         report = None
         if progress:
