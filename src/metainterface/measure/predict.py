@@ -1,13 +1,21 @@
-"""The made part's friction law: the BEM on its measured cell, and the forward model with
-its fitted asperities, against the design's target.
+"""The made part's friction law: the BEM on its measured cell, as measured, against the
+design's target; the forward model with the fitted asperities beside it, as a fast
+companion.
 
 The measured cell: every point of an M x M grid of the unit cell is looked up in each copy
 of the cell that the scan shows (through the registered lattice, bilinearly, levelled) and
 the copies are averaged: noise falls as 1 / sqrt(copies) and the cell is periodic by
-construction. Points no copy shows (a partial-cell scan, missing points) take the fitted
-family's surface, and their share is reported; a Gaussian of half a grid step takes the
-instrument's pixel noise off (``SMOOTH``). The error is the package's one curve error
-(``physics.metrics.curve_error``) on the target's grid, with coverage.
+construction. M is the scan's own resolution, never coarser. Points no copy shows (a
+partial-cell scan, missing points) take the fitted family's surface, and their share is
+reported. Nothing is smoothed that could be a real feature: what the family cannot
+describe (layer steps, flat tips) is found and restored, and noise is treated only as far
+as the scan's noise floor says (``measure.shapes``).
+
+The made error is read from the BEM curve itself, at loads over the target's range, against
+the target there (the package's one curve error, ``physics.metrics.curve_error``); the same
+cell on a grid half as fine gives the BEM's own discretisation error beside it. Contacts
+narrower than ``RESOLVED_PIXELS`` scan pixels are not resolved by the scan: the prediction
+holds from the load on which they carry at most ``UNRESOLVED_SHARE`` of the contact area.
 """
 
 from __future__ import annotations
@@ -23,39 +31,41 @@ import torch
 from metainterface.measure.fit import levelled
 from metainterface.measure.register import Registration
 from metainterface.measure.scan import Scan
+from metainterface.measure.shapes import Shapes, analyse, restore
 from metainterface.measure.surface import lattice_surface
 from metainterface.physics.cell import Design
 from metainterface.physics.metrics import curve_error
 from metainterface.physics.registry import get_model
 from metainterface.validation import owner_map, solve_path
 
-#: Points of the uniform grid every curve error is measured on (as ``validation``'s).
+#: BEM grid points per scan pixel (``default_grid``).
+GRID_PER_PIXEL = 2.0
+#: Points of the uniform grid the fitted model's curve errors are measured on.
 ERROR_POINTS = 128
-#: Gaussian smoothing of the measured cell [grid steps]: half a step takes most of a
-#: scan's pixel noise off (0.1 um at R = 0.5 mm read the first contacts' area 1.8 % low on
-#: a 255^2 cell, 0.8 % with it; benchmarks/bench_measure.py) and leaves the tips' shapes.
-SMOOTH = 0.5
 #: Where BEM and fitted model differ by more than this, the fitted family misses a shape.
 DISAGREE = 0.03
+#: A contact narrower (in diameter) than this many scan pixels is not resolved by the scan.
+RESOLVED_PIXELS = 4.0
+#: The prediction holds where unresolved contacts carry at most this share of the area.
+UNRESOLVED_SHARE = 0.05
 
 
 @dataclass(frozen=True)
 class MeasuredCell:
-    """heights: (M, M) the measured unit cell [R], tips up, highest point 0; spacing: L / M
-    [R]; copies: (M, M) number of cell copies averaged at each point; filled: share of the
-    points no copy showed (taken from the fitted surface)."""
+    """heights: (M, M) the measured unit cell [R], tips up, in the registration's height
+    frame (made tips at -h); fitted: (M, M) the fitted family's surface there; spacing:
+    L / M [R]; copies: (M, M) number of cell copies averaged at each point; filled: share
+    of the points no copy showed (taken from the fitted surface)."""
 
     heights: np.ndarray
+    fitted: np.ndarray
     spacing: float
     copies: np.ndarray
     filled: float
 
 
-def measured_cell(
-    scan: Scan, reg: Registration, design: Design, grid: int, smooth: float = 0.0
-) -> MeasuredCell:
-    """The phase-averaged measured cell on a grid x grid grid (module docstring), smoothed
-    by a Gaussian of ``smooth`` grid steps (0: not at all)."""
+def measured_cell(scan: Scan, reg: Registration, design: Design, grid: int) -> MeasuredCell:
+    """The phase-averaged measured cell on a grid x grid grid (module docstring)."""
     from scipy import ndimage
 
     s = design.settings
@@ -88,20 +98,20 @@ def measured_cell(
     if seen.any():
         mean = total[seen] / count[seen]
         heights[seen] = mean - np.median(mean - fitted[seen])  # onto the fitted level
-    if smooth > 0:  # the instrument's noise off (periodic), the shapes kept
-        heights = ndimage.gaussian_filter(heights, smooth, mode="wrap")
-    heights -= heights.max()
     return MeasuredCell(
-        heights=heights + 0.0, spacing=spacing, copies=count, filled=float(1 - seen.mean())
+        heights=heights, fitted=fitted, spacing=spacing, copies=count, filled=float(1 - seen.mean())
     )
 
 
 def default_grid(scan: Scan, design: Design) -> int:
-    """M for the measured cell: the scan's own resolution per cell (its finer axis), a
-    multiple of n, between 64 n and 256 n points."""
+    """M for the measured cell: twice the scan's own resolution per cell (its finer axis),
+    rounded up to a multiple of n, between 64 n and 256 n points. Never coarser than the
+    scan; twice as fine because restored layer steps are sharper than the scan's pixels and
+    a BEM on the scan's own grid reads a terraced cell's area 2-5 % high where twice as
+    fine reads it within 1.2 % (tests/measure/test_printed.py holds it to 4 %)."""
     n = design.settings.n_side
     per_cell = design.settings.cell_side / min(scan.dx, scan.dy)
-    m = round(per_cell / n) * n
+    m = math.ceil(GRID_PER_PIXEL * per_cell / n - 1e-9) * n
     return int(min(max(m, 64 * n), 256 * n))
 
 
@@ -139,48 +149,120 @@ def curve_errors(
     design: Design,
     target: tuple[np.ndarray, np.ndarray],
     model: Any = None,
-    ratio: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(error (B,), coverage (B,)) of the cells (gamma, h) (B, N) against ``target``, on its
-    ERROR_POINTS grid. ratio: (loads (K,), alpha_bem / alpha_model (K,)) multiplies the
-    model's alpha, interpolated (held at the ends): the BEM's error, as ``validate``'s."""
+    """(error (B,), coverage (B,)) of the cells (gamma, h) (B, N) by the forward model
+    against ``target``, on its ERROR_POINTS grid (the fitted family's errors)."""
     p_t, a_t = target
     grid = np.linspace(0.0, float(p_t[-1]), ERROR_POINTS)
     ref = np.interp(grid, p_t, a_t, left=0.0)
     alpha, p_max = model_alpha(gamma, h, design, grid, model)
-    if ratio is not None:
-        alpha = alpha * np.interp(grid, ratio[0], np.nan_to_num(ratio[1], nan=1.0))
     b = alpha.shape[0]
     err = curve_error(alpha, np.tile(ref, (b, 1)), np.tile(grid, (b, 1)), p_max)
     return np.asarray(err), np.minimum(1.0, p_max / p_t[-1])
+
+
+def bem_error(p_star: np.ndarray, alpha: np.ndarray, target: tuple[np.ndarray, np.ndarray]):
+    """The curve error of a BEM curve alpha (..., K) at its loads p_star (K,) against the
+    target read at those loads (a BEM cell reaches every load: coverage 1)."""
+    ref = np.interp(p_star, target[0], target[1], left=0.0)
+    a = np.atleast_2d(alpha)
+    err = curve_error(
+        a, np.broadcast_to(ref, a.shape), np.broadcast_to(p_star, a.shape), np.full(len(a), np.inf)
+    )
+    return np.asarray(err)
+
+
+def loads_over(target: tuple[np.ndarray, np.ndarray], loads: int) -> np.ndarray:
+    """K loads, uniform up to the target's largest [P*]."""
+    return float(target[0][-1]) * np.arange(1, loads + 1) / loads
+
+
+def coarse_grid(grid: int, n: int) -> int:
+    """The second grid of the discretisation estimate: half as fine, a multiple of n."""
+    return max(16 * n, round(grid / 2 / n) * n)
+
+
+def resolved_from(
+    p_star: np.ndarray, asperity_alpha: np.ndarray, cell_side: float, pixel: float
+) -> float | None:
+    """The lowest load [P*] from which on contacts narrower than RESOLVED_PIXELS scan
+    pixels carry at most UNRESOLVED_SHARE of the contact area (None: at no load)."""
+    area = asperity_alpha * cell_side**2
+    diameter = 2.0 * np.sqrt(area / math.pi)
+    small = (area > 0) & (diameter < RESOLVED_PIXELS * pixel)
+    share = (area * small).sum(axis=1) / np.maximum(area.sum(axis=1), 1e-300)
+    ok = share <= UNRESOLVED_SHARE
+    bad = np.flatnonzero(~ok)
+    if bad.size == 0:
+        return float(p_star[0])
+    if bad[-1] == len(p_star) - 1:
+        return None
+    return float(p_star[bad[-1] + 1])
 
 
 @dataclass(frozen=True)
 class Prediction:
     """The made part's law.
 
-    p_star: (K,) BEM loads; alpha_bem, alpha_fit, alpha_design: (K,) the BEM on the measured
-    cell, the forward model with the fitted asperities, the design's model. error_bem,
-    error_fit, error_design, coverage_*: curve errors to the target (and coverage).
-    disagree: (K,) bool, where abs(alpha_bem / alpha_fit - 1) > DISAGREE. cell: the measured
-    cell solved. share: (N,) each asperity's share of the made curve error (the error of
-    the design with that asperity alone made as measured, normalised over the asperities).
-    error_alone: (N,) those errors.
+    p_star: (K,) BEM loads over the target's range; alpha_bem: (K,) the BEM on the measured
+    cell (restored: ``shapes``); alpha_coarse: (K,) the same on the coarse grid;
+    alpha_target: (K,) the target there; alpha_fit, alpha_design: (K,) the forward model
+    with the fitted asperities, and the design's. error_bem: the made error, from the BEM
+    curve at its loads; error_accuracy: the BEM's own discretisation error on that figure
+    (its difference from the coarse grid's); error_fit, error_design, coverage_fit: the
+    forward model's curve errors. grid, grid_coarse: the BEM grids. resolved_from: the load
+    [P*] from which on the scan resolves the contacts (None: nowhere). disagree: (K,) bool,
+    where abs(alpha_bem / alpha_fit - 1) > DISAGREE. cell: the measured cell solved
+    (``heights`` as restored). shapes: what the family cannot describe. share: (N,) each
+    asperity's share of the made curve error (the error of the design with that asperity
+    alone made as measured, normalised); error_alone: (N,) those errors.
     """
 
     p_star: np.ndarray
     alpha_bem: np.ndarray
+    alpha_coarse: np.ndarray
+    alpha_target: np.ndarray
     alpha_fit: np.ndarray
     alpha_design: np.ndarray
     error_bem: float
+    error_accuracy: float
     error_fit: float
     error_design: float
     coverage_fit: float
+    grid: int
+    grid_coarse: int
+    resolved_from: float | None
     disagree: np.ndarray
     cell: MeasuredCell
+    shapes: Shapes
     share: np.ndarray
     error_alone: np.ndarray
     target: tuple[np.ndarray, np.ndarray]
+
+
+def solve_cell(
+    heights: np.ndarray,
+    design: Design,
+    p_star: np.ndarray,
+    *,
+    engine: Any = None,
+    device: Any = "auto",
+    report: Callable[[int], Any] | None = None,
+):
+    """The BEM load path (``validation.LoadPath``) of a cell (M, M) [R], tips up."""
+    s = design.settings
+    m = heights.shape[0]
+    return solve_path(
+        heights - heights.max(),
+        s.cell_side,
+        p_star,
+        owner_map(s.n_side, m),
+        s.n_asperities,
+        engine=engine,
+        device=device,
+        threads=None,
+        report=report,
+    )
 
 
 def predict(
@@ -194,65 +276,73 @@ def predict(
     report: Callable[[int], Any] | None = None,
     engine: Any = None,
     device: Any = "auto",
-    smooth: float = SMOOTH,
+    z_step: float | None = None,
 ) -> Prediction:
-    """BEM of the measured cell and the fitted model, against the design's target.
+    """BEM of the measured cell (and of it on a grid half as fine), the fitted model beside
+    it, against the design's target (module docstring).
 
     grid: M of the measured cell (default ``default_grid``); loads: K BEM loads, uniform up
-    to the made part's P*_max (or the target's largest load); model: the forward model;
-    report: called with 1 after each load; engine, device: the BEM's (``solve_path``);
-    smooth: the measured cell's Gaussian smoothing [grid steps]."""
+    to the target's largest; model: the forward model; report: called with 1 after each
+    load of either grid; engine, device: the BEM's (``solve_path``); z_step: the printer's
+    layer step [R] where known (else read from the scan)."""
     s = design.settings
     target = target_of(design, model)
     grid = default_grid(scan, design) if grid is None else grid
-    cell = measured_cell(scan, reg, design, grid, smooth=smooth)
+    grid2 = coarse_grid(grid, s.n_side)
+    raw = measured_cell(scan, reg, design, grid)
+    owner = owner_map(s.n_side, grid)
+    shapes = analyse(raw.heights, raw.fitted, owner, scan, raw.copies, design, reg.gamma, z_step)
+    cell = restore(raw.heights, owner, shapes)
+    raw2 = measured_cell(scan, reg, design, grid2)
+    cell2 = restore(raw2.heights, owner_map(s.n_side, grid2), shapes)
+    p = loads_over(target, loads)
+    path = solve_cell(cell, design, p, engine=engine, device=device, report=report)
+    path2 = solve_cell(cell2, design, p, engine=engine, device=device, report=report)
+    errs_bem = bem_error(p, np.stack([path.alpha, path2.alpha]), target)
     h_design = design.h - design.h.min()
-    _, p_max = model_alpha(reg.gamma, reg.h, design, target[0][-1:], model)
-    top = float(min(p_max[0], target[0][-1]))
-    p = top * np.arange(1, loads + 1) / loads
-    path = solve_path(
-        cell.heights,
-        s.cell_side,
-        p,
-        owner_map(s.n_side, grid),
-        s.n_asperities,
-        engine=engine,
-        device=device,
-        threads=None,
-        report=report,
-    )
     both, _ = model_alpha(
         np.stack([reg.gamma, design.gamma]), np.stack([reg.h, h_design]), design, p, model
     )
     alpha_fit, alpha_design = both
-    ratio = path.alpha / alpha_fit
     errs, cover = curve_errors(
-        np.stack([reg.gamma, reg.gamma, design.gamma]),
-        np.stack([reg.h, reg.h, h_design]),
-        design,
-        target,
-        model,
+        np.stack([reg.gamma, design.gamma]), np.stack([reg.h, h_design]), design, target, model
     )
-    err_bem, _ = curve_errors(reg.gamma[None], reg.h[None], design, target, model, (p, ratio))
     n = s.n_asperities
     g_alone = np.tile(design.gamma, (n, 1))
     h_alone = np.tile(h_design, (n, 1))
     g_alone[np.arange(n), np.arange(n)] = reg.gamma
     h_alone[np.arange(n), np.arange(n)] = reg.h
     alone, _ = curve_errors(g_alone, h_alone, design, target, model)
-    excess = np.maximum(alone - errs[2], 0.0)
+    excess = np.maximum(alone - errs[1], 0.0)
     share = excess / excess.sum() if excess.sum() > 0 else np.zeros(n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(alpha_fit > 0, path.alpha / alpha_fit, np.inf)
     return Prediction(
         p_star=p,
         alpha_bem=path.alpha,
+        alpha_coarse=path2.alpha,
+        alpha_target=np.interp(p, target[0], target[1], left=0.0),
         alpha_fit=alpha_fit,
         alpha_design=alpha_design,
-        error_bem=float(err_bem[0]),
+        error_bem=float(errs_bem[0]),
+        error_accuracy=float(abs(errs_bem[0] - errs_bem[1])),
         error_fit=float(errs[0]),
-        error_design=float(errs[2]),
+        error_design=float(errs[1]),
         coverage_fit=float(cover[0]),
+        grid=grid,
+        grid_coarse=grid2,
+        resolved_from=resolved_from(
+            p, path.asperity_alpha, s.cell_side, max(scan.dx, scan.dy)
+        ),
         disagree=np.abs(ratio - 1.0) > DISAGREE,
-        cell=cell,
+        cell=MeasuredCell(
+            heights=cell,
+            fitted=raw.fitted,
+            spacing=raw.spacing,
+            copies=raw.copies,
+            filled=raw.filled,
+        ),
+        shapes=shapes,
         share=share,
         error_alone=alone,
         target=target,

@@ -92,7 +92,7 @@ def measure(
         if progress:
             from tqdm.auto import tqdm
 
-            bar = stack.enter_context(tqdm(total=loads, desc="BEM loads", unit="load"))
+            bar = stack.enter_context(tqdm(total=2 * loads, desc="BEM loads", unit="load"))
             report = bar.update
         pred = predict(
             s, reg, design, grid=grid, loads=loads, model=model, report=report, device=device
