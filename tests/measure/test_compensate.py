@@ -59,6 +59,8 @@ def test_the_print_made_by_the_map_meets_the_target(design):
     assert comp.printed.gamma[0] == pytest.approx(s.gamma_min, abs=0.01)
     g, h = pmap.made(comp.printed.gamma, comp.printed.h)
     err, cover = curve_errors(g[None], h[None], design, target_of(design))
-    assert err[0] == pytest.approx(comp.error_after, abs=1e-9)
+    assert err[0] == pytest.approx(comp.error_family, abs=1e-9)
     assert err[0] < 0.01 and cover[0] == 1.0
+    # judged in BEM on the made cell (power laws only here): as good as the family says
+    assert comp.error_after < 0.01
     assert comp.error_before > 0.05

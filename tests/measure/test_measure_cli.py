@@ -35,19 +35,26 @@ def test_measure_writes_its_files(files, capsys):
         "--modulus", "2MPa", "--shear-strength", "0.5MPa", "--area", "1cm^2",
         "--compensate", "--loads", "3", "--out", str(out),
     ]  # fmt: skip
-    assert main(argv) == 0
-    assert "made error" in capsys.readouterr().out
+    # the part is about 8 % off its target: above the default --max-error of 5 %
+    assert main(argv) == 3
+    out_text = capsys.readouterr().out
+    assert "made error (BEM" in out_text and "above --max-error 5 %" in out_text
+    assert "orientation: as designed" in out_text
+    assert main([*argv[:-2], "--max-error", "50%", "--out", str(folder / "out2")]) == 0
     names = {p.name for p in out.iterdir()}
     assert {"measured.json", "bem.csv", "measured.png", "compensated.json"} <= names
     summary = json.loads((out / "measured.json").read_text())
     gamma = [a["gamma_made"] for a in summary["asperities"] if a["cells_seen"]]
     design = [a["gamma_design"] for a in summary["asperities"] if a["cells_seen"]]
     np.testing.assert_allclose(np.subtract(gamma, design), 0.1, atol=0.02)
-    table = np.loadtxt(out / "bem.csv", delimiter=",", skiprows=1)
-    assert table.shape == (3, 6)
+    table = np.loadtxt(out / "bem.csv", delimiter=",", skiprows=2)
+    assert table.shape == (3, 8)  # p_star, 5 curves, normal force and friction in N
     comp = json.loads((out / "compensated.json").read_text())
     assert comp["format"] == "metainterface/design-v1"
     assert comp["compensation"]["predicted_made_error_after"] < 0.01
+    # R and the process model are recorded: export needs no --radius again
+    assert comp["physical"]["radius_m"] == pytest.approx(R)
+    assert comp["compensation"]["process"]["map"]["gamma_shift"] == pytest.approx(0.1, abs=0.02)
 
 
 @pytest.mark.parametrize(
@@ -89,10 +96,12 @@ def test_also_joins_more_scans_to_the_map(files, tmp_path):
         "measure", scan, "--design", str(folder / "design.json"), "--radius", "0.5mm",
         "--size", f"{width * 1e3}mm", "--height-unit", "um", "--loads", "2", "--compensate",
         "--also", scan, str(folder / "design.json"), "--out", str(tmp_path / "out"),
+        "--max-error", "50%",
     ]  # fmt: skip
     assert main(argv) == 0
     comp = json.loads((tmp_path / "out" / "compensated.json").read_text())
-    assert comp["compensation"]["gamma_shift"] == pytest.approx(0.1, abs=0.02)
+    process = comp["compensation"]["process"]
+    assert process["map"]["gamma_shift"] == pytest.approx(0.1, abs=0.02)
 
 
 def test_also_without_compensate(files, capsys, tmp_path):

@@ -103,9 +103,11 @@ def test_files(design, measured, tmp_path):
     for row in rows:  # each asperity's made height is the mean over its cells
         mine = [c["h_um"] for c in cells if c["k"] == row["k"]]
         assert np.mean(mine) == pytest.approx(row["h_made_um"], abs=1e-6)
-    header = (tmp_path / "bem.csv").read_text().splitlines()[0].split(",")
+    lines = (tmp_path / "bem.csv").read_text().splitlines()
+    assert json.loads(lines[0][2:])["settings"]["command"] == "measure"  # provenance
+    header = lines[1].split(",")
     assert header[:2] == ["p_star", "alpha_bem"] and "friction_N" in header
-    table = np.loadtxt(tmp_path / "bem.csv", delimiter=",", skiprows=1)
+    table = np.loadtxt(tmp_path / "bem.csv", delimiter=",", skiprows=2)
     # friction = tau alpha A, normal force = P* E* A
     np.testing.assert_allclose(table[:, header.index("friction_N")], 0.5e6 * table[:, 1] * 1e-4)
     np.testing.assert_allclose(table[:, header.index("normal_force_N")], 2e6 * table[:, 0] * 1e-4)

@@ -54,6 +54,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="with --compensate: another scan of the same print and the design it was "
         "printed from, whose asperities join the map from designed to made (repeatable)",
     )
+    p.add_argument(
+        "--z-step",
+        help="the printer's layer step, e.g. 1um: the correction models the layers with it "
+        "(default: read from the scan where it shows terraces)",
+    )
+    p.add_argument(
+        "--max-error",
+        default="5%",
+        help="exit status 3 when the made error (BEM) is above this (default 5%%)",
+    )
     p.add_argument("--loads", type=int, default=8, help="BEM loads (default 8)")
     p.add_argument(
         "--grid",
@@ -73,7 +83,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import metainterface as mi
+    from metainterface.manufacture.tolerance import _max_error
 
+    max_error = _max_error(args.max_error, "--max-error")
     size = None if args.size is None else [s.strip() for s in args.size.split(",")]
     if size is not None and len(size) not in (1, 2):
         raise mi.MetainterfaceError("--size takes one length or two, e.g. 4mm,3mm")
@@ -92,7 +104,8 @@ def run(args: argparse.Namespace) -> int:
         out=args.out,
         compensate=args.compensate,
         device=args.device,
+        z_step=args.z_step,
         also=[tuple(pair) for pair in args.also],
     )
-    print(repr(result))
-    return 0
+    print(result.report(max_error))
+    return 3 if result.error > max_error else 0

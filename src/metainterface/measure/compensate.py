@@ -1,15 +1,21 @@
-"""The next print corrected: the systematic map from designed to made, fitted from one or
-more (design, registration) pairs, and the geometry to send to the printer so that the
-*made* part meets the target.
+"""The next print corrected, checked as it will be made.
 
-The map (``PrintMap``): gamma_made = gamma + shift + bias_gamma_k, and
-h_made = scale h + bias_h_k (h anchored, min 0; the made heights aligned on the design's
-mean, ``register``), the per-asperity biases the mean residuals at lattice index k (kept
-only when every pair has N asperities, all seen; else none, the height bias a common
-offset). The printed geometry starts from the map's
-inverse applied to the design (the made part would then be the design), clipped to the
-printer's bounds (the design's gamma bounds, h >= 0), and is refined with the map inside:
-the forward model's curve of map(printed) is fitted to the target.
+The process (:class:`Process`), modelled from the scan(s): the systematic map from designed
+to made (``PrintMap``: gamma_made = gamma + shift + bias_gamma_k, h_made = scale h +
+bias_h_k, h anchored at min 0, the made heights aligned on the design's mean as
+``register`` aligns them; the per-asperity biases the mean residuals at lattice index k,
+kept only when every pair has N asperities, all seen), and what the power-law family cannot
+express: tips cut flat ``flat_depth`` below their apex, and the printer's layer levels
+(``measure.shapes.Terraces``: read from the scan, or the step given as ``z_step``). The
+made cell of any printed geometry follows: the map's power laws, cut, on the levels.
+
+The printed geometry starts from the map's inverse applied to the design (clipped to the
+printer's bounds: the design's gamma bounds, h >= 0) refined in the forward model with the
+map inside; then, since the cuts and the layers move the curve in ways the family cannot,
+the made cell of that print is solved in BEM and the ratio of its curve to the family's
+corrects the target the family is refined to, a few rounds. Every candidate is judged by
+the BEM of its predicted made cell at loads over the target's range; the best is kept only
+if it beats the design itself printed as it is.
 """
 
 from __future__ import annotations
@@ -21,13 +27,25 @@ import numpy as np
 import torch
 
 from metainterface.errors import MetainterfaceError
-from metainterface.measure.predict import ERROR_POINTS, curve_errors, target_of
+from metainterface.measure.predict import (
+    ERROR_POINTS,
+    bem_error,
+    curve_errors,
+    loads_over,
+    model_alpha,
+    solve_cell,
+    target_of,
+)
 from metainterface.measure.register import Registration
+from metainterface.measure.shapes import Shapes, Terraces, on_levels
+from metainterface.measure.surface import asperity_index, lattice_surface
 from metainterface.physics.cell import Design
 from metainterface.physics.registry import get_model
 
 #: Steps of the refinement with the map inside.
 REFINE_STEPS = 150
+#: Rounds of the BEM correction after the family's own.
+ROUNDS = 2
 
 
 @dataclass(frozen=True)
@@ -83,59 +101,226 @@ def fit_map(pairs: list[tuple[Design, Registration]]) -> PrintMap:
 
 
 @dataclass(frozen=True)
-class Compensation:
-    """printed: the design to send to the printer; pmap: the map used; error_before,
-    error_after: predicted made errors (forward model) of the design and of ``printed``,
-    each printed as the map says."""
+class Process:
+    """How the printer makes a geometry: ``pmap`` (designed -> made power laws),
+    ``flat_depth`` [R] (tips cut this far below their apex; 0: none) and ``terraces`` (the
+    layer levels in the made heights' frame, or None)."""
 
-    printed: Design
     pmap: PrintMap
+    flat_depth: float = 0.0
+    terraces: Terraces | None = None
+
+    def made_cell(self, gamma: np.ndarray, h: np.ndarray, design: Design, grid: int):
+        """(grid, grid) heights [R] of the made cell of the printed (gamma, h) (N,)."""
+        s = design.settings
+        gm, hm = self.pmap.made(np.asarray(gamma, float), np.asarray(h, float))
+        spacing = s.cell_side / grid
+        u, v = np.meshgrid(np.arange(grid) * spacing, np.arange(grid) * spacing)
+        z = lattice_surface(u, v, -hm, gm, s)
+        if self.flat_depth > 0:
+            k = asperity_index(u, v, s)
+            z = np.minimum(z, -hm[k] - self.flat_depth)
+        if self.terraces is not None:
+            z = on_levels(z, self.terraces)
+        return z
+
+    def to_dict(self, radius_m: float) -> dict[str, Any]:
+        um = 1e6 * radius_m
+        t = self.terraces
+        return {
+            "map": self.pmap.to_dict(radius_m),
+            "flat_depth_um": self.flat_depth * um,
+            "layer_step_um": None if t is None else t.step * um,
+            "layer_phase_um": None if t is None else t.phase * um,
+            "layer_step_given": None if t is None else t.given,
+        }
+
+
+def process_from(
+    pairs: list[tuple[Design, Registration, Shapes]], z_step: float | None = None
+) -> Process:
+    """The process from (design, registration, shapes) triples: the map (``fit_map``), the
+    flat depth (the median, over the flat tips seen, of the fitted apex less the plateau)
+    and the layer levels of the first scan that shows them (step ``z_step`` [R] if given)."""
+    pmap = fit_map([(d, r) for d, r, _ in pairs])
+    depths = []
+    for _, reg, shapes in pairs:
+        flat = (shapes.flat_radius > 0) & (reg.seen > 0)
+        depths.extend((-reg.h[flat] - shapes.plateau[flat]).tolist())
+    depth = max(0.0, float(np.median(depths))) if depths else 0.0
+    terraces = next((sh.terraces for _, _, sh in pairs if sh.terraces is not None), None)
+    if z_step is not None and terraces is not None and not terraces.given:
+        terraces = Terraces(z_step, terraces.phase, terraces.coherence, given=True)
+    elif z_step is not None and terraces is None:
+        terraces = Terraces(z_step, 0.0, 0.0, given=True)
+    return Process(pmap=pmap, flat_depth=depth, terraces=terraces)
+
+
+@dataclass(frozen=True)
+class Compensation:
+    """The correction. printed: the design to send to the printer, or None where no
+    candidate beats printing the design as it is; process: the model it was made for;
+    error_before, error_after: the made errors (BEM of the predicted made cell, at p_star)
+    of the design and of ``printed`` (the design's again where printed is None);
+    alpha_before, alpha_after: (K,) their BEM curves; p_star: (K,) the loads;
+    error_family: the forward model's error of ``printed`` made by the map alone (what the
+    family predicts); limits: what the correction cannot reach, in words."""
+
+    printed: Design | None
+    process: Process
     error_before: float
     error_after: float
+    error_family: float
+    p_star: np.ndarray
+    alpha_before: np.ndarray
+    alpha_after: np.ndarray
+    limits: list[str]
+
+    @property
+    def pmap(self) -> PrintMap:
+        return self.process.pmap
+
+    @property
+    def improved(self) -> bool:
+        return self.printed is not None
 
 
 def compensate(
-    design: Design, pmap: PrintMap, *, model: Any = None, steps: int = REFINE_STEPS
+    design: Design,
+    process: Process | PrintMap,
+    *,
+    model: Any = None,
+    steps: int = REFINE_STEPS,
+    grid: int = 192,
+    loads: int = 8,
+    rounds: int = ROUNDS,
+    engine: Any = None,
+    device: Any = "auto",
+    radius_m: float | None = None,
 ) -> Compensation:
-    """Pre-distort ``design`` for the map ``pmap`` (module docstring)."""
+    """Pre-distort ``design`` for ``process`` (module docstring), each candidate judged by
+    the BEM of its predicted made cell on grid x grid at ``loads`` loads over the target's
+    range. radius_m: R [m], recorded in the printed design file (so that ``export`` need not
+    be told it again)."""
+    if isinstance(process, PrintMap):
+        process = Process(pmap=process)
+    pmap = process.pmap
     s = design.settings
     target = target_of(design, model)
+    p = loads_over(target, loads)
     h_design = design.h - design.h.min()
-    # the inverse: printed such that made = design
+
+    def judged(g: np.ndarray, h: np.ndarray) -> tuple[float, np.ndarray]:
+        path = solve_cell(
+            process.made_cell(g, h, design, grid), design, p, engine=engine, device=device
+        )
+        return float(bem_error(p, path.alpha, target)[0]), path.alpha
+
+    before, a_before = judged(design.gamma, h_design)
+    # the family's own correction: the map's inverse, refined with the map inside
     g0 = np.clip(design.gamma - pmap.gamma_shift - pmap.gamma_bias, s.gamma_min, s.gamma_max)
     h0 = (h_design - pmap.h_bias) / pmap.h_scale
     h0 = h0 - h0.min()
-    before = _made_error(design.gamma, h_design, pmap, design, target, model)
-    start = _made_error(g0, h0, pmap, design, target, model)
-    g1, h1 = _refine(g0, h0, pmap, design, target, model, steps)
-    after = _made_error(g1, h1, pmap, design, target, model)
-    if start <= after:
-        g1, h1, after = g0, h0, start
+    g, h = _refine(g0, h0, pmap, design, target, model, steps)
+    best: tuple[float, np.ndarray, np.ndarray, np.ndarray] | None = None
+    p_t, a_t = target
+    for i in range(rounds + 1):
+        err, alpha = judged(g, h)
+        if best is None or err < best[0]:
+            best = (err, g, h, alpha)
+        if i == rounds:
+            break
+        # the BEM over the family at the loads: the part of the curve the family cannot say
+        gm, hm = pmap.made(best[1], best[2])
+        fam, _ = model_alpha(gm[None], hm[None], design, p, model)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(fam[0] > 0, best[3] / fam[0], 1.0)
+        ratio = np.clip(np.nan_to_num(ratio, nan=1.0, posinf=1.0), 0.2, 5.0)
+        corrected = (p_t, a_t / np.interp(p_t, p, ratio))
+        g, h = _refine(best[1], best[2], pmap, design, corrected, model, steps)
+    assert best is not None
+    after, g1, h1, a_after = best
+    gm, hm = pmap.made(g1, h1)
+    family, _ = curve_errors(gm[None], hm[None], design, target, model)
+    limits = _limits(design, g1, p, a_after, target, after)
+    if after >= before:
+        limits.insert(
+            0,
+            f"no correction beats the design printed as it is ({100 * before:.3g} % made "
+            f"error; the best correction reads {100 * after:.3g} %): none is written",
+        )
+        return Compensation(
+            printed=None,
+            process=process,
+            error_before=before,
+            error_after=before,
+            error_family=float(family[0]),
+            p_star=p,
+            alpha_before=a_before,
+            alpha_after=a_before,
+            limits=limits,
+        )
+    extras = {k: v for k, v in design.extras.items() if k not in ("provenance", "physical")}
+    extras["target"] = {"p_star": [float(v) for v in p_t], "alpha": [float(v) for v in a_t]}
+    if radius_m is not None:
+        extras["physical"] = {"radius_m": float(radius_m)}
+    extras["compensation"] = {
+        "predicted_made_error_before": before,
+        "predicted_made_error_after": after,
+        "predicted_by": f"BEM of the predicted made cell, {grid}^2, {loads} loads",
+        "family_error_after": float(family[0]),
+        "process": process.to_dict(radius_m if radius_m is not None else 1.0),
+        "process_units": "um" if radius_m is not None else "units of R (no radius given)",
+        "limits": limits,
+    }
     printed = Design(
-        gamma=np.clip(g1, s.gamma_min, s.gamma_max),
-        h=h1 - h1.min(),
-        settings=s,
-        extras={
-            **{k: v for k, v in design.extras.items() if k != "provenance"},
-            "target": {
-                "p_star": [float(v) for v in target[0]],
-                "alpha": [float(v) for v in target[1]],
-            },
-            "compensation": {
-                "predicted_made_error_before": before,
-                "predicted_made_error_after": after,
-                "gamma_shift": pmap.gamma_shift,
-                "h_scale": pmap.h_scale,
-            },
-        },
+        gamma=np.clip(g1, s.gamma_min, s.gamma_max), h=h1 - h1.min(), settings=s, extras=extras
     )
-    return Compensation(printed=printed, pmap=pmap, error_before=before, error_after=after)
+    return Compensation(
+        printed=printed,
+        process=process,
+        error_before=before,
+        error_after=after,
+        error_family=float(family[0]),
+        p_star=p,
+        alpha_before=a_before,
+        alpha_after=a_after,
+        limits=limits,
+    )
 
 
-def _made_error(g, h, pmap, design, target, model) -> float:
-    gm, hm = pmap.made(np.asarray(g), np.asarray(h))
-    err, _ = curve_errors(gm[None], hm[None], design, target, model)
-    return float(err[0])
+def _limits(
+    design: Design,
+    gamma: np.ndarray,
+    p: np.ndarray,
+    alpha: np.ndarray,
+    target: tuple[np.ndarray, np.ndarray],
+    error: float,
+) -> list[str]:
+    """What the correction cannot reach, in words."""
+    s = design.settings
+    out = []
+    low = np.flatnonzero(gamma <= s.gamma_min + 1e-6)
+    high = np.flatnonzero(gamma >= s.gamma_max - 1e-6)
+    if low.size:
+        out.append(
+            f"asperities {', '.join(map(str, low))} at the printer's lowest exponent "
+            f"({s.gamma_min:g}): they cannot be made blunter"
+        )
+    if high.size:
+        out.append(
+            f"asperities {', '.join(map(str, high))} at the highest exponent ({s.gamma_max:g})"
+        )
+    ref = np.interp(p, target[0], target[1], left=0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.where(ref > 0, alpha / ref - 1.0, 0.0)
+    if error > 0.01 and rel.size:
+        j = int(np.argmax(np.abs(rel)))
+        out.append(
+            f"the made curve stays {100 * rel[j]:+.2g} % off the target at P* = {p[j]:.3g} "
+            f"(load {j + 1} of {len(p)}): the cut tips and the layers decide it there"
+        )
+    return out
 
 
 def _refine(g0, h0, pmap, design, target, model, steps):

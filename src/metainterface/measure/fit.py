@@ -200,10 +200,13 @@ def fit_asperities(
     tilt: np.ndarray,
     *,
     gamma_start: float | None = None,
+    top_band: float = 0.0,
 ) -> AsperityFits:
     """Stage 2 (module docstring): every asperity whose tip is in the scan and whose disc is
     at least ``MIN_COVER`` measured. gamma_start: one exponent to start every fit from
-    (before the lattice's orientation is known); None: the design's at each position."""
+    (before the lattice's orientation is known); None: the design's at each position.
+    top_band [R]: points within this of an asperity's highest are left out of its fit (a
+    flat or terraced top is no power law's: the flank gives the tip the print cut)."""
     s = design.settings
     n = s.n_side
     p = lattice.design_pitch
@@ -252,7 +255,9 @@ def fit_asperities(
     width_ = max(a.size for a in xs)
     pad = np.zeros((3, b, width_))
     mask = np.zeros((b, width_), dtype=bool)
+    fitted = np.zeros((b, width_), dtype=bool)  # the points the fit uses (below the top band)
     for i, (a, c, d) in enumerate(zip(xs, ys, zs_, strict=True)):
+        fitted[i, : a.size] = d < d.max() - top_band if top_band > 0 else True
         pad[0, i, : a.size], pad[1, i, : a.size], pad[2, i, : a.size] = a, c, d
         mask[i, : a.size] = True
     kinds = np.array([m[0] for m in meta])
@@ -275,7 +280,8 @@ def fit_asperities(
         ],
         dim=1,
     )
-    weight = m / m.sum(1, keepdim=True).sqrt() / zsc  # each asperity's mean square
+    mf = torch.as_tensor(fitted)
+    weight = mf / mf.sum(1, keepdim=True).sqrt() / zsc  # each asperity's mean square
 
     def fun(x: torch.Tensor, idx: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         return _asperity_residuals(x, pu[idx], pv[idx], zt[idx], weight[idx], p, zsc, s.radius)

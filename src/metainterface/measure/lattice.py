@@ -176,9 +176,11 @@ def lattice_at(
     return Lattice(origin=origin, theta=theta, pitch=pitch, design_pitch=design_pitch)
 
 
-def explained(lat: Lattice, design: Design, scan: Scan) -> tuple[float, np.ndarray]:
+def explained(lat: Lattice, design: Design, scan: Scan) -> tuple[float, np.ndarray, float]:
     """Share of the scan's height variance that the designed map (scaled) and a plane
-    explain on ``lat``, and that plane's slopes (2,) (dz/dx, dz/dy)."""
+    explain on ``lat``, that plane's slopes (2,) (dz/dx, dz/dy), and the scale of the
+    designed map's heights that does it (about 1 for a part as made; 1000 for a height
+    unit slip)."""
     return _explained(lat, design, *_sample(scan))
 
 
@@ -192,15 +194,15 @@ def _sample(scan: Scan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def _explained(
     lat: Lattice, design: Design, x: np.ndarray, y: np.ndarray, z: np.ndarray
-) -> tuple[float, np.ndarray]:
-    """Share of var(z) explained by a * designed map + tilt plane (linear least squares), and
-    that plane's slopes (2,)."""
+) -> tuple[float, np.ndarray, float]:
+    """Share of var(z) explained by a * designed map + tilt plane (linear least squares),
+    that plane's slopes (2,) and a."""
     u, v = lat.to_cell(x, y)
     s = design.settings
     t = lattice_surface(u, v, -(design.h - design.h.min()), design.gamma, s)
     a = np.stack([t, x, y, np.ones_like(x)], axis=1)
     coef, *_ = np.linalg.lstsq(a, z, rcond=None)
     if coef[0] <= 0:
-        return 0.0, coef[1:3]
+        return 0.0, coef[1:3], float(coef[0])
     res = z - a @ coef
-    return float(1.0 - res.var() / max(z.var(), 1e-300)), coef[1:3]
+    return float(1.0 - res.var() / max(z.var(), 1e-300)), coef[1:3], float(coef[0])

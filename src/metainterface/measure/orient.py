@@ -48,7 +48,9 @@ class Orientation:
     was reversed (the scan registered is the mirrored one); shift: the unit cell's corner
     (columns, rows) in lattice squares; score: the share of the fitted asperities'
     variation the common map leaves unexplained; margin: the next best orientation's score
-    over this one's; runner_up: that orientation, in words; ambiguous: margin < MIN_MARGIN.
+    over this one's; runner_up: that orientation, in words; ambiguous: margin < MIN_MARGIN;
+    height_scale: the scale of the designed map's heights that best explains the scan's
+    (about 1 for a part as made; 1000 or 0.001 for a height unit slip).
     """
 
     quarter_turns: int
@@ -58,6 +60,7 @@ class Orientation:
     margin: float
     runner_up: str
     ambiguous: bool
+    height_scale: float = 1.0
 
     def describe(self) -> str:
         """The orientation in words, e.g. 'turned 90 degrees, mirrored (y reversed)'."""
@@ -73,6 +76,7 @@ class Orientation:
             "margin": self.margin,
             "runner_up": self.runner_up,
             "ambiguous": self.ambiguous,
+            "height_scale": self.height_scale,
         }
 
 
@@ -138,7 +142,7 @@ def orient(
         if runner is None
         else max(runner.score, SCORE_FLOOR) / max(best.score, SCORE_FLOOR)
     )
-    share, tilt = explained(best.lattice, design, best.scan)
+    share, tilt, height_scale = explained(best.lattice, design, best.scan)
     if share < MIN_EXPLAINED:
         raise MetainterfaceError(
             "scan does not show this design's lattice: the designed map explains "
@@ -153,6 +157,7 @@ def orient(
         margin=float(margin),
         runner_up="none" if runner is None else _words(runner.turns, runner.mirror),
         ambiguous=bool(margin < MIN_MARGIN),
+        height_scale=height_scale,
     )
     return best.scan, best.lattice, tilt, share, orientation
 

@@ -103,6 +103,22 @@ def measured_cell(scan: Scan, reg: Registration, design: Design, grid: int) -> M
     )
 
 
+def shapes_of(
+    scan: Scan,
+    reg: Registration,
+    design: Design,
+    grid: int | None = None,
+    z_step: float | None = None,
+) -> tuple[MeasuredCell, Shapes]:
+    """The measured cell on ``grid`` (default ``default_grid``) and what it shows beyond the
+    fitted family (``measure.shapes.analyse``), before any restoration."""
+    grid = default_grid(scan, design) if grid is None else grid
+    raw = measured_cell(scan, reg, design, grid)
+    owner = owner_map(design.settings.n_side, grid)
+    shapes = analyse(raw.heights, raw.fitted, owner, scan, raw.copies, design, reg.gamma, z_step)
+    return raw, shapes
+
+
 def default_grid(scan: Scan, design: Design) -> int:
     """M for the measured cell: twice the scan's own resolution per cell (its finer axis),
     rounded up to a multiple of n, between 64 n and 256 n points. Never coarser than the
@@ -166,9 +182,8 @@ def bem_error(p_star: np.ndarray, alpha: np.ndarray, target: tuple[np.ndarray, n
     target read at those loads (a BEM cell reaches every load: coverage 1)."""
     ref = np.interp(p_star, target[0], target[1], left=0.0)
     a = np.atleast_2d(alpha)
-    err = curve_error(
-        a, np.broadcast_to(ref, a.shape), np.broadcast_to(p_star, a.shape), np.full(len(a), np.inf)
-    )
+    ones = np.ones_like(a)
+    err = curve_error(a, ref * ones, p_star * ones, np.full(len(a), np.inf))
     return np.asarray(err)
 
 
@@ -289,9 +304,8 @@ def predict(
     target = target_of(design, model)
     grid = default_grid(scan, design) if grid is None else grid
     grid2 = coarse_grid(grid, s.n_side)
-    raw = measured_cell(scan, reg, design, grid)
+    raw, shapes = shapes_of(scan, reg, design, grid, z_step)
     owner = owner_map(s.n_side, grid)
-    shapes = analyse(raw.heights, raw.fitted, owner, scan, raw.copies, design, reg.gamma, z_step)
     cell = restore(raw.heights, owner, shapes)
     raw2 = measured_cell(scan, reg, design, grid2)
     cell2 = restore(raw2.heights, owner_map(s.n_side, grid2), shapes)
@@ -331,9 +345,7 @@ def predict(
         coverage_fit=float(cover[0]),
         grid=grid,
         grid_coarse=grid2,
-        resolved_from=resolved_from(
-            p, path.asperity_alpha, s.cell_side, max(scan.dx, scan.dy)
-        ),
+        resolved_from=resolved_from(p, path.asperity_alpha, s.cell_side, max(scan.dx, scan.dy)),
         disagree=np.abs(ratio - 1.0) > DISAGREE,
         cell=MeasuredCell(
             heights=cell,

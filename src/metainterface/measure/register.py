@@ -18,8 +18,11 @@ from metainterface.measure.fit import AsperityFits, fit_asperities, fit_lattice
 from metainterface.measure.lattice import Lattice
 from metainterface.measure.orient import Orientation, orient
 from metainterface.measure.scan import Scan
+from metainterface.measure.shapes import noise_floor
 from metainterface.physics.cell import Design
 
+#: Floor of the top band left out of the final asperity fits [units of Delta_max].
+TOP_BAND = 0.01
 #: Rounds of the lattice fit for scans that show each asperity once (``fit.fit_lattice``).
 TIED_ROUNDS = 8
 
@@ -83,7 +86,10 @@ def register(scan: Scan, design: Design) -> Registration:
             scan, design, lattice, tilt, z0, gamma, tied=tied, rounds=TIED_ROUNDS if tied else 2
         )
         lattice, tilt = refined.lattice, refined.tilt
-        fits = fit_asperities(scan, design, lattice, tilt)
+        # the final fit leaves each top's noise band out: a flat tip's plateau is no power
+        # law's, and its flank still gives where the tip would have been
+        band = 3.0 * noise_floor(scan) + TOP_BAND * design.settings.delta_max
+        fits = fit_asperities(scan, design, lattice, tilt, top_band=band)
     if fits.kind.size == 0:
         raise MetainterfaceError(
             "scan does not show this design's lattice: no asperity is seen whole enough to fit"

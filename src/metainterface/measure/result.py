@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from metainterface.measure.compensate import Compensation, compensate, fit_map
-from metainterface.measure.predict import Prediction
+from metainterface.measure.compensate import Compensation, compensate, process_from
+from metainterface.measure.predict import DISAGREE, RESOLVED_PIXELS, Prediction
 from metainterface.measure.register import Registration
 from metainterface.measure.scan import Scan
 from metainterface.physics.cell import Design
@@ -75,7 +75,8 @@ class MeasureResult:
         return (
             f"MeasureResult({int(r.seen.sum())} asperities fitted in {self.scan.source}, "
             f"rotation {math.degrees(r.lattice.theta):.3g} deg; made error "
-            f"{100 * p.error_bem:.3g} % (BEM), {100 * p.error_fit:.3g} % (fitted model); "
+            f"{100 * p.error_bem:.3g} % +- {100 * p.error_accuracy:.2g} % (BEM), "
+            f"{100 * p.error_fit:.3g} % (fitted model); "
             f"design {100 * p.error_design:.3g} %{self._compensated()})"
         )
 
@@ -83,17 +84,138 @@ class MeasureResult:
         c = self.compensation
         if c is None:
             return ""
+        if c.printed is None:
+            return "; no correction improves the made part"
         return (
             f"; compensated print: made error {100 * c.error_before:.3g} % -> "
-            f"{100 * c.error_after:.3g} % (predicted)"
+            f"{100 * c.error_after:.3g} % (BEM of the predicted made cell)"
         )
 
-    def compensate(self, *others: MeasureResult, model: Any = None) -> Compensation:
-        """The geometry to print so that the made part meets the target: the map from
-        designed to made fitted on this result (and ``others``, more (design, scan) pairs),
-        the design pre-distorted by it (``measure.compensate``)."""
-        pairs = [(m.design, m.registration) for m in (self, *others)]
-        return compensate(self.design, fit_map(pairs), model=model)
+    def compensate(
+        self, *others: MeasureResult, model: Any = None, z_step: Any = None
+    ) -> Compensation:
+        """The geometry to print so that the made part meets the target: the process
+        modelled from this result (and ``others``, more scans of the same print: their maps
+        and shapes join), the design pre-distorted for it and checked in BEM on its
+        predicted made cell (``measure.compensate``). z_step: the printer's layer step
+        (e.g. "1um") where known."""
+        z = None
+        if z_step is not None:
+            from metainterface.units import parse_length
+
+            z = parse_length(z_step, option="z_step") / self.scan.radius_m
+        triples = [(m.design, m.registration, m.prediction.shapes) for m in (self, *others)]
+        return compensate(
+            self.design,
+            process_from(triples, z_step=z),
+            model=model,
+            grid=self.prediction.grid,
+            loads=len(self.prediction.p_star),
+            radius_m=self.scan.radius_m,
+        )
+
+    def warnings(self) -> list[str]:
+        """Everything a user should know before trusting the figures, one line each."""
+        r, p = self.registration, self.prediction
+        sh = p.shapes
+        um = 1e6 * self.scan.radius_m
+        o = r.orientation
+        out = []
+        if o.ambiguous:
+            out.append(
+                f"orientation: {o.describe()} fits only {o.margin:.2g}x better than "
+                f"{o.runner_up}: too close to tell apart (the per-asperity figures may "
+                "belong to other asperities)"
+            )
+        if not 1 / 30 < o.height_scale < 30:
+            out.append(height_slip(o.height_scale))
+        if sh.terraces is not None:
+            t = sh.terraces
+            out.append(
+                f"terraces: layer steps of {t.step * um:.3g} um "
+                f"({'as given' if t.given else 'read from the scan'}); heights restored onto "
+                "them before the BEM"
+            )
+        flat = np.flatnonzero(sh.flat_radius > 0)
+        if flat.size:
+            radii = ", ".join(f"{k}: {sh.flat_radius[k] * um:.3g}" for k in flat)
+            out.append(f"flat tips (radius in um) on asperities {radii}; made flat before the BEM")
+        for k, what in enumerate(sh.feature):
+            if what:
+                out.append(f"asperity {k}: {what} (more than Delta_max/3 from its fitted shape)")
+        if sh.smoothed > 0:
+            out.append(
+                f"scan noise {sh.noise * um:.2g} um: the cell smoothed by a Gaussian of "
+                f"{sh.smoothed:.2g} grid steps"
+            )
+        if p.resolved_from is None:
+            out.append("the scan's pixels resolve the contacts at none of the loads")
+        elif p.resolved_from > p.p_star[0]:
+            out.append(
+                f"below P* = {p.resolved_from:.3g} the contacts are narrower than "
+                f"{RESOLVED_PIXELS:g} scan pixels: the prediction holds from there on"
+            )
+        if p.cell.filled > 0:
+            out.append(
+                f"{100 * p.cell.filled:.2g} % of the cell is not in the scan: filled with the "
+                "fitted asperities"
+            )
+        if np.any(p.disagree):
+            out.append(
+                "BEM on the measured cell and the fitted model differ by more than "
+                f"{100 * DISAGREE:g} % at P* = "
+                + ", ".join(f"{v:.3g}" for v in p.p_star[p.disagree])
+                + ": the made shapes are not all power laws (the BEM's figure is the one)"
+            )
+        return out
+
+    def report(self, max_error: float | None = None) -> str:
+        """The summary a user reads on screen: the made error from BEM with its accuracy,
+        the orientation found, the worst asperities in um, every warning, the correction."""
+        r, p, d = self.registration, self.prediction, self.design
+        um = 1e6 * self.scan.radius_m
+        lines = [
+            f"scan {self.scan.source}: {self.scan.shape[1]} x {self.scan.shape[0]} points, "
+            f"{self.scan.dx * um:.3g} um pixels; {int(r.seen.sum())} asperities fitted",
+            f"orientation: {r.orientation.describe()}, rotation "
+            f"{math.degrees(r.lattice.theta):.3g} deg (margin {r.orientation.margin:.2g}x over "
+            f"{r.orientation.runner_up})",
+            f"made error (BEM on the measured cell, {p.grid}^2, {len(p.p_star)} loads): "
+            f"{100 * p.error_bem:.3g} % +- {100 * p.error_accuracy:.2g} % (the BEM's own, "
+            f"from {p.grid_coarse}^2); fitted model {100 * p.error_fit:.3g} %, design "
+            f"{100 * p.error_design:.3g} %",
+        ]
+        h_design = d.h - d.h.min()
+        dev = (r.h - h_design) * um
+        worst = np.argsort(-p.share)[:3]
+        parts = [
+            f"{k} (gamma {d.gamma[k]:.3g} -> {r.gamma[k]:.3g}, h {dev[k]:+.3g} um, "
+            f"{100 * p.share[k]:.0f} % of the error)"
+            for k in worst
+            if p.share[k] > 0
+        ]
+        if parts:
+            lines.append("worst asperities: " + "; ".join(parts))
+        lines += [f"warning: {w}" for w in self.warnings()]
+        c = self.compensation
+        if c is not None:
+            if c.printed is None:
+                lines.append(
+                    f"correction: none written; the design printed as it is reads "
+                    f"{100 * c.error_before:.3g} % (BEM of the predicted made cell)"
+                )
+            else:
+                lines.append(
+                    f"correction: predicted made error {100 * c.error_before:.3g} % -> "
+                    f"{100 * c.error_after:.3g} % (BEM of the predicted made cell; the fitted "
+                    f"family alone would say {100 * c.error_family:.3g} %)"
+                )
+            lines += [f"correction cannot reach: {t}" for t in c.limits]
+        if max_error is not None and p.error_bem > max_error:
+            lines.append(
+                f"made error {100 * p.error_bem:.3g} % is above --max-error {100 * max_error:.3g} %"
+            )
+        return "\n".join(lines)
 
     # --- reports -------------------------------------------------------------------------
 
@@ -169,11 +291,21 @@ class MeasureResult:
             "tilt": [float(t) for t in r.tilt],
             "explained_variance": r.explained,
             "asperities_fitted": int(r.seen.sum()),
+            "orientation": r.orientation.to_dict(),
             "error_bem": p.error_bem,
+            "error_bem_accuracy": p.error_accuracy,
+            "error_bem_read": (
+                f"the BEM curve at {len(p.p_star)} loads over the target's range against the "
+                f"target there; accuracy: its difference from the same on {p.grid_coarse}^2"
+            ),
+            "resolved_from_p_star": p.resolved_from,
             "error_fit": p.error_fit,
             "error_design": p.error_design,
             "coverage": p.coverage_fit,
-            "bem_grid": int(p.cell.heights.shape[0]),
+            "bem_grid": int(p.grid),
+            "bem_grid_coarse": int(p.grid_coarse),
+            "shapes": self._shapes(),
+            "warnings": self.warnings(),
             "bem_filled_share": p.cell.filled,
             "disagree_p_star": [float(v) for v in p.p_star[p.disagree]],
             "asperities": self.asperities(),
@@ -185,20 +317,56 @@ class MeasureResult:
             },
         }
         if np.any(p.disagree):
-            out["disagreement"] = (
-                "BEM on the measured cell and the fitted model differ by more than 3 % at "
-                "P* = "
-                + ", ".join(f"{v:.3g}" for v in p.p_star[p.disagree])
-                + ": the made shapes are not all power laws (tips, flanks, debris)"
-            )
+            out["disagreement"] = next(w for w in self.warnings() if "not all power laws" in w)
+        c = self.compensation
+        if c is not None:
+            out["compensation"] = {
+                "written": c.printed is not None,
+                "predicted_made_error_before": c.error_before,
+                "predicted_made_error_after": c.error_after,
+                "family_error_after": c.error_family,
+                "process": c.process.to_dict(self.scan.radius_m),
+                "limits": c.limits,
+            }
         return out
 
+    def _axes(self, um: float) -> tuple[np.ndarray, np.ndarray]:
+        """The design's cell axes in the scan [um]: an origin near the scan's centre and
+        the ends of u and v, a quarter of the scan long."""
+        lat = self.registration.lattice
+        w, h = self.scan.size
+        u0, v0 = lat.to_cell(np.array(0.5 * w), np.array(0.5 * h))
+        length = 0.25 * min(w, h) / lat.scale
+        pts = [lat.to_scan(u0 + a, v0 + b) for a, b in ((0, 0), (length, 0), (0, length))]
+        xy = np.array([[float(x), float(y)] for x, y in pts]) * um
+        return xy[0], xy[1:]
+
+    def _shapes(self) -> dict[str, Any]:
+        sh = self.prediction.shapes
+        um = 1e6 * self.scan.radius_m
+        t = sh.terraces
+        return {
+            "noise_um": sh.noise * um,
+            "cell_noise_um": sh.cell_noise * um,
+            "layer_step_um": None if t is None else t.step * um,
+            "layer_phase_um": None if t is None else t.phase * um,
+            "layer_coherence": None if t is None else t.coherence,
+            "flat_tip_radius_um": [float(v * um) for v in sh.flat_radius],
+            "features": sh.feature,
+            "restored": sh.restored(),
+        }
+
     def bem_table(self) -> str:
-        """bem.csv: p_star, alpha_bem, alpha_fit, alpha_design (+ forces in N)."""
+        """bem.csv: a '# ' provenance line, then p_star, alpha_bem, alpha_bem_coarse,
+        alpha_target, alpha_fit, alpha_design (+ forces in N)."""
+        from metainterface._files.provenance import csv_header
+
         p = self.prediction
         cols: dict[str, np.ndarray] = {
             "p_star": p.p_star,
             "alpha_bem": p.alpha_bem,
+            "alpha_bem_coarse": p.alpha_coarse,
+            "alpha_target": p.alpha_target,
             "alpha_fit": p.alpha_fit,
             "alpha_design": p.alpha_design,
         }
@@ -206,6 +374,17 @@ class MeasureResult:
             fn, ff = self.friction.forces(p.p_star, p.alpha_bem)
             cols["normal_force_N"], cols["friction_N"] = fn, ff
         buf = io.StringIO()
+        buf.write(
+            csv_header(
+                command="measure",
+                scan=self.scan.source,
+                scan_sha256=_array_hash(self.scan.heights),
+                design=self.design.to_dict(),
+                radius_m=self.scan.radius_m,
+                grid=int(p.grid),
+                loads=len(p.p_star),
+            )
+        )
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(cols)
         for row in zip(*cols.values(), strict=True):
@@ -246,7 +425,7 @@ class MeasureResult:
 
         plt.close(fig)
         out.append(folder / "measured.png")
-        if isinstance(compensated, Compensation):
+        if isinstance(compensated, Compensation) and compensated.printed is not None:
             out.append(compensated.printed.save(folder / "compensated.json"))
         return out
 
@@ -274,8 +453,27 @@ class MeasureResult:
             target=p.target,
             error_bem=p.error_bem,
             error_design=p.error_design,
+            orientation=f"{r.orientation.describe()}, {math.degrees(r.lattice.theta):.3g} deg",
+            lattice=self._axes(um),
             to_forces=None if self.friction is None else self.friction.forces,
         )
+
+
+def _array_hash(a: np.ndarray) -> str:
+    import hashlib
+
+    digest = hashlib.sha256(np.ascontiguousarray(a, dtype=np.float64).tobytes()).hexdigest()
+    return "sha256:" + digest[:16]
+
+
+def height_slip(scale: float) -> str:
+    """The warning for a scan whose heights are ``scale`` times the design's."""
+    factor = 10.0 ** (3 * round(math.log10(scale) / 3))
+    return (
+        f"the scan's heights are about {scale:.3g} times the design's: a height unit slip? "
+        f"(give the unit, e.g. --height-unit {'nm' if factor > 1 else 'mm'} where um was "
+        f"read; a factor {factor:g})"
+    )
 
 
 def _finite(value: float) -> float | None:

@@ -10,8 +10,8 @@ from typing import Any
 
 from metainterface.errors import MetainterfaceError
 from metainterface.measure.compensate import compensate as compensate_design
-from metainterface.measure.compensate import fit_map
-from metainterface.measure.predict import predict
+from metainterface.measure.compensate import process_from
+from metainterface.measure.predict import predict, shapes_of
 from metainterface.measure.register import register
 from metainterface.measure.result import Friction, MeasureResult
 from metainterface.measure.scan import as_scan
@@ -36,6 +36,7 @@ def measure(
     compensate: bool = False,
     out: str | os.PathLike[str] | None = None,
     device: Any = "auto",
+    z_step: Any = None,
     also: Sequence[tuple[Any, Design | str | os.PathLike[str]]] = (),
 ) -> MeasureResult:
     """Measure a made part: read, level and register its scan, fit every asperity of every
@@ -48,14 +49,17 @@ def measure(
     is metres). size, height_unit: the scan's lateral size and height unit where its file
     has none (an array's heights are in ``height_unit``, default metres). modulus,
     shear_strength, area: E* [Pa], tau [Pa], nominal area [m^2] (all three or none), for
-    friction in newtons. grid: the measured cell's BEM grid (default: the scan's own
-    resolution, 64 n to 256 n). loads: BEM loads. progress: a bar over the BEM loads.
-    compensate: also design the next print (``MeasureResult.compensation``; the same as
-    ``.compensate()`` later). out: a folder to write measured.json, bem.csv, measured.png
-    (and compensated.json) in (``MeasureResult.write``). device: where the BEM runs
-    ("auto", "cpu", "cuda", "cuda:N"). also: more (scan, design) pairs of the same print
-    (read as ``scan`` is), registered only, whose made asperities join this one's in the
-    map from designed to made that ``compensate`` fits.
+    friction in newtons. grid: the measured cell's BEM grid (default: twice the scan's
+    resolution, 64 n to 256 n). loads: BEM loads (the error's accuracy comes from the same
+    loads on a grid half as fine). progress: a bar over the BEM loads. compensate: also
+    design the next print (``MeasureResult.compensation``; the same as ``.compensate()``
+    later), judged in BEM on its predicted made cell and kept only if it improves.
+    z_step: the printer's layer step (e.g. "1um") where known (else read from the scan's
+    terraces). out: a folder to write measured.json, bem.csv, measured.png (and
+    compensated.json) in (``MeasureResult.write``). device: where the BEM runs ("auto",
+    "cpu", "cuda", "cuda:N"). also: more (scan, design) pairs of the same print (read as
+    ``scan`` is), registered only, whose made asperities and shapes join this one's in the
+    process that ``compensate`` models.
 
     Returns a :class:`MeasureResult` (``.registration``, ``.prediction``, ``.error``,
     ``.compensate()``, ``.write(folder)``). Raises MetainterfaceError in one line: unknown
@@ -75,6 +79,7 @@ def measure(
         raise MetainterfaceError("size is for a scan file; an array takes pixel_size")
     s = as_scan(scan, radius=radius, pixel_size=pixel_size, **read)
     friction = _friction(modulus, shear_strength, area)
+    z = None if z_step is None else _length(z_step, "z_step") / s.radius_m
     if isinstance(loads, bool) or not isinstance(loads, int) or not 2 <= loads <= 200:
         raise MetainterfaceError(f"loads must be a whole number in [2, 200], got {loads!r}")
     if out is not None:
@@ -86,6 +91,13 @@ def measure(
 
         grid = check_grid(grid, design.settings)
     reg = register(s, design)
+    if not 1 / 30 < reg.orientation.height_scale < 30:
+        import warnings
+
+        from metainterface.errors import UnitSlipWarning
+        from metainterface.measure.result import height_slip
+
+        warnings.warn(height_slip(reg.orientation.height_scale), UnitSlipWarning, stacklevel=2)
     s = reg.scan  # as registered: mirrored where the file's y axis runs the other way
     with contextlib.ExitStack() as stack:
         report = None
@@ -95,23 +107,46 @@ def measure(
             bar = stack.enter_context(tqdm(total=2 * loads, desc="BEM loads", unit="load"))
             report = bar.update
         pred = predict(
-            s, reg, design, grid=grid, loads=loads, model=model, report=report, device=device
+            s,
+            reg,
+            design,
+            grid=grid,
+            loads=loads,
+            model=model,
+            report=report,
+            device=device,
+            z_step=z,
         )
     result = MeasureResult(
         scan=s, design=design, registration=reg, prediction=pred, friction=friction
     )
     if compensate:
-        pairs = [(design, reg)]
+        triples = [(design, reg, pred.shapes)]
         for other_scan, other_design in also:
             d = other_design if isinstance(other_design, Design) else Design.load(other_design)
             other = as_scan(other_scan, radius=radius, pixel_size=pixel_size, **read)
-            pairs.append((d, register(other, d)))
-        comp = compensate_design(design, fit_map(pairs), model=model)
+            other_reg = register(other, d)
+            triples.append((d, other_reg, shapes_of(other_reg.scan, other_reg, d, z_step=z)[1]))
+        comp = compensate_design(
+            design,
+            process_from(triples, z_step=z),
+            model=model,
+            grid=pred.grid,
+            loads=loads,
+            device=device,
+            radius_m=s.radius_m,
+        )
         result = dataclasses.replace(result, compensation=comp)
 
     if out is not None:
         result.write(out)
     return result
+
+
+def _length(value: Any, name: str) -> float:
+    from metainterface.units import parse_length
+
+    return parse_length(value, option=name)
 
 
 def _friction(modulus: Any, shear_strength: Any, area: Any) -> Friction | None:

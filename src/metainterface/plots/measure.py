@@ -19,12 +19,16 @@ def measure_figure(
     target: tuple[np.ndarray, np.ndarray],
     error_bem: float,
     error_design: float,
+    orientation: str | None = None,
+    lattice: tuple[np.ndarray, np.ndarray] | None = None,
     to_forces: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
 ) -> Figure:
     """Four panels. scan, designed: (ny, nx) levelled heights [um] on the scan's grid;
     extent: (x0, x1, y0, y1) [um]; p_star, alpha_bem, alpha_fit: (K,); target: (p, alpha).
-    to_forces: (p_star, alpha) -> (normal force, friction) [N]; with it the law is drawn
-    as friction against normal force."""
+    orientation: the orientation found, in words (the scan panel's title); lattice: the
+    design's cell axes in the scan, ((2,) origin, (2, 2) u and v ends) [um], drawn as arrows
+    on the scan. to_forces: (p_star, alpha) -> (normal force, friction) [N]; with it the
+    law is drawn as friction against normal force."""
     fig = Figure(figsize=(13, 3.6), layout="constrained")
     axes = fig.subplots(1, 4)
     lo, hi = np.nanpercentile(designed, [1, 100])
@@ -33,9 +37,18 @@ def measure_figure(
         (axes[1], designed, "designed, registered [um]"),
     ):
         im = ax.imshow(data, origin="lower", extent=extent, vmin=lo, vmax=hi, cmap="viridis")
-        ax.set_title(title)
+        ax.set_title(title, fontsize=9)
         ax.set_xlabel("x [um]")
         fig.colorbar(im, ax=ax, shrink=0.8)
+    if orientation is not None:
+        axes[0].set_title(f"scan, levelled [um]\nfound: {orientation}", fontsize=9)
+    if lattice is not None:  # the design's u (white) and v (red) axes where they lie
+        o, ends = lattice
+        for end, colour, name in ((ends[0], "w", "u"), (ends[1], "r", "v")):
+            axes[0].annotate(
+                "", xy=end, xytext=o, arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.5}
+            )
+            axes[0].text(*end, name, color=colour, fontsize=9)
     diff = scan - designed
     lim = float(np.nanpercentile(np.abs(diff), 99)) or 1.0
     im = axes[2].imshow(diff, origin="lower", extent=extent, vmin=-lim, vmax=lim, cmap="RdBu_r")
