@@ -2,8 +2,9 @@
 restored before the BEM: the scan's noise floor, a printer's layer steps (terraces), flat
 tips, missing or extra material.
 
-- **Noise floor**: the scan's pixel noise, from the median absolute difference between each
-  point and the mean of its four neighbours (robust to steps and edges, which are few).
+- **Noise floor**: the scan's pixel noise, from the median absolute fourth difference
+  along the rows and the columns (blind to the surface's curvature; robust to steps and
+  edges where they are a minority of the points).
   The measured cell averages the copies of the cell the scan shows, so its noise is lower.
 - **Terraces**: a layered print puts every height on a level ``phase + k step``. Among the
   flattest points of the cell's top (those whose 3 x 3 neighbourhood spans the least: the
@@ -33,6 +34,12 @@ from metainterface.physics.cell import Design
 MIN_COHERENCE = 0.5
 #: Share of the top's points, the flattest, on which terraces are looked for.
 TREAD_SHARE = 0.3
+#: Smallest layer step looked for [units of Delta_max] (finer ones are no printer's).
+MIN_STEP = 0.05
+#: Fewest tread points below an asperity's top level for its flank to count.
+MIN_LEVEL_POINTS = 20
+#: Fewest tread points to read layers from.
+MIN_TREAD_POINTS = 200
 #: Depth of the top looked at [units of Delta_max]: where contact happens.
 TOP_DEPTH = 2.0
 #: Cell noise [units of Delta_max] below which the measured cell is left as it is.
@@ -40,7 +47,7 @@ NOISE_TOLERANCE = 0.005
 #: A flat tip: its plateau's radius at least this many scan pixels, and this many times the
 #: fitted power law's own within the same height band.
 FLAT_PIXELS = 2.0
-FLAT_RATIO = 2.0
+FLAT_RATIO = 1.4
 #: Material further than this from the fitted asperity [units of Delta_max] is reported.
 FEATURE_DEPTH = 1.0 / 3.0
 #: The bilinear read's share of a pixel's noise (sum of the squared weights, on average
@@ -93,30 +100,45 @@ class Shapes:
 
 
 def noise_floor(scan: Scan) -> float:
-    """The scan's pixel noise [R]: 1.4826 MAD of z less the mean of its 4 neighbours,
-    over sqrt(1 + 1/4) (white noise's share in that difference)."""
+    """The scan's pixel noise [R]: 1.4826 MAD of the fourth differences along x and y,
+    over sqrt(70) (white noise's share in them). A fourth difference leaves out the
+    surface's own curvature, which at a coarse pixel is as large as the noise; a layer step
+    is an outlier the median passes over, unless the risers are most of the points (a
+    densely terraced scan with pixels wider than its treads): it then reads high."""
     z = scan.heights
-    mean4 = 0.25 * (z[:-2, 1:-1] + z[2:, 1:-1] + z[1:-1, :-2] + z[1:-1, 2:])
-    d = (z[1:-1, 1:-1] - mean4).ravel()
-    d = d[np.isfinite(d)]
+    parts = []
+    for a in (z, z.T):
+        d = a[:, :-4] - 4 * a[:, 1:-3] + 6 * a[:, 2:-2] - 4 * a[:, 3:-1] + a[:, 4:]
+        parts.append(d[np.isfinite(d)])
+    d = np.concatenate(parts)
     if d.size < 16:
         return 0.0
     mad = np.median(np.abs(d - np.median(d)))
-    return float(1.4826 * mad / math.sqrt(1.25))
+    return float(1.4826 * mad / math.sqrt(70.0))
 
 
 def find_terraces(
-    cell: np.ndarray, noise: float, delta_max: float, step: float | None = None
+    cell: np.ndarray,
+    noise: float,
+    delta_max: float,
+    step: float | None = None,
+    owner: np.ndarray | None = None,
 ) -> Terraces | None:
     """Layer levels of a measured cell (M, M) [R] (module docstring), or None. step: the
-    layer step when known (``--z-step``): only its phase is read."""
+    layer step when known (``--z-step``): only its phase is read. owner: (M, M) asperity
+    index: the levels must show on most asperities' flanks too, below their top level, with
+    a coherence of ``MIN_COHERENCE`` (a few flat tops at round heights are no layers)."""
     from scipy import ndimage
 
+    def spread(z: np.ndarray) -> np.ndarray:
+        return ndimage.maximum_filter(z, 3, mode="wrap") - ndimage.minimum_filter(z, 3, mode="wrap")
+
     top = cell > cell.max() - TOP_DEPTH * delta_max
-    spread = ndimage.maximum_filter(cell, 3, mode="wrap") - ndimage.minimum_filter(
-        cell, 3, mode="wrap"
-    )
-    flat = top & (spread <= np.quantile(spread[top], TREAD_SHARE))
+    mine = spread(cell)
+    flat = top & (mine <= np.quantile(mine[top], TREAD_SHARE))
+    if flat.sum() < MIN_TREAD_POINTS:
+        return None if step is None else Terraces(step, 0.0, 0.0, given=True)
+    owner_flat = None if owner is None else owner[flat]
     z = cell[flat]
     if z.size > 40_000:
         z = z[:: math.ceil(z.size / 40_000)]
@@ -130,10 +152,10 @@ def find_terraces(
     if step is not None:
         c = coherence(np.array([1.0 / step]))[0]
         return Terraces(step, _phase(c, step), float(abs(c)), given=True)
-    # frequencies from 4 levels over the top to six noise widths a level; steps of a tenth
+    # frequencies from 4 levels over the top to ten noise widths a level; steps of a tenth
     # of the peak's width (1 / span)
     f_lo = 4.0 / span
-    f_hi = 1.0 / max(6.0 * noise, 1e-3 * delta_max)
+    f_hi = 1.0 / max(10.0 * noise, MIN_STEP * delta_max)
     if f_hi <= f_lo:
         return None
     f = np.arange(f_lo, f_hi, 0.1 / span)
@@ -159,7 +181,27 @@ def find_terraces(
         (phase, step), *_ = np.linalg.lstsq(a, z[near], rcond=None)
         phase = float(phase) % float(step)
     c = coherence(np.array([1.0 / step]))[0]
-    return Terraces(float(step), _phase(c, float(step)), float(abs(c)))
+    terraces = Terraces(float(step), _phase(c, float(step)), float(abs(c)))
+    if (
+        owner_flat is not None
+        and _flank_coherence(cell[flat], owner_flat, terraces) < MIN_COHERENCE
+    ):
+        return None
+    return terraces
+
+
+def _flank_coherence(z: np.ndarray, owner: np.ndarray, t: Terraces) -> float:
+    """The median over the asperities of the levels' coherence on their tread points below
+    their top level (a flat or top tread left out: a few tops at round heights would look
+    like layers; real layers show on the flanks too)."""
+    values = []
+    for a in np.unique(owner):
+        za = z[owner == a]
+        k = np.round((za - t.phase) / t.step)
+        below = za[k < k.max()]
+        if below.size >= MIN_LEVEL_POINTS:
+            values.append(abs(np.exp(2j * np.pi * below / t.step).mean()))
+    return float(np.median(values)) if values else 0.0
 
 
 def _phase(c: complex, step: float) -> float:
@@ -187,13 +229,14 @@ def analyse(
     s = design.settings
     noise = noise_floor(scan)
     cell_noise = BILINEAR_NOISE * noise * float(np.sqrt(np.mean(1.0 / np.maximum(copies, 1))))
-    terraces = find_terraces(cell, cell_noise, s.delta_max, z_step)
-    work = on_levels(cell, terraces) if terraces is not None else cell
     n = s.n_asperities
+    noise_band = max(3.0 * cell_noise, 1e-4 * s.delta_max)
+    terraces = find_terraces(cell, cell_noise, s.delta_max, z_step, owner)
+    work = on_levels(cell, terraces) if terraces is not None else cell
     m = cell.shape[0]
     spacing = s.cell_side / m
     pixel = max(scan.dx, scan.dy)
-    band = max(3.0 * cell_noise, 1e-4 * s.delta_max) if terraces is None else 1e-9
+    band = noise_band if terraces is None else 1e-9
     flat_radius, plateau = np.zeros(n), np.full(n, np.nan)
     feature = [""] * n
     from scipy import ndimage
@@ -203,20 +246,22 @@ def analyse(
     c = shape_constant(np.asarray(gamma, dtype=np.float64), s.radius)
     for k in range(n):
         mine = owner == k
-        zk = np.where(mine, work, -np.inf)
-        peak = np.unravel_index(int(np.argmax(zk)), zk.shape)
-        top = float(zk[peak])
-        near = zk >= top - band
-        lab, _ = ndimage.label(near)
-        area = float((lab == lab[peak]).sum()) * spacing**2
+        region, top = _plateau(work, mine, band)
+        area = float(region.sum()) * spacing**2
         radius = math.sqrt(area / math.pi)
         own = (band / c[k]) ** (1.0 / gamma[k]) + spacing
         if radius > max(FLAT_PIXELS * pixel, FLAT_RATIO * own):
             flat_radius[k], plateau[k] = radius, top
-        diff = np.where(mine & (fitted > fitted[mine].max() - s.delta_max), cell - fitted, 0.0)
-        if diff.max() > FEATURE_DEPTH * s.delta_max:
+        # material off the fitted shape, outside a flat top (a cut tip is reported as one)
+        # and beyond half a layer (the steps' own)
+        body = mine & (fitted > fitted[mine].max() - s.delta_max)
+        if flat_radius[k] > 0:
+            body &= ~ndimage.binary_dilation(region, iterations=2)
+        depth = FEATURE_DEPTH * s.delta_max + (0.5 * terraces.step if terraces else 0.0)
+        diff = np.where(body, work - fitted, 0.0)
+        if diff.max() > depth:
             feature[k] = "extra material"
-        elif diff.min() < -FEATURE_DEPTH * s.delta_max:
+        elif diff.min() < -depth:
             feature[k] = "missing material"
     smoothed = 0.0
     tolerance = NOISE_TOLERANCE * s.delta_max
@@ -232,6 +277,19 @@ def analyse(
         feature=feature,
         smoothed=smoothed,
     )
+
+
+def _plateau(z: np.ndarray, mine: np.ndarray, band: float) -> tuple[np.ndarray, float]:
+    """The points of ``mine`` connected to its highest that lie within ``band`` of it, and
+    that height, both read on z's 3 x 3 median (a noise spike is no top)."""
+    from scipy import ndimage
+
+    zs = ndimage.median_filter(z, 3, mode="wrap")
+    zk = np.where(mine, zs, -np.inf)
+    peak = np.unravel_index(int(np.argmax(zk)), zk.shape)
+    top = float(zk[peak])
+    lab, _ = ndimage.label(zk >= top - band)
+    return lab == lab[peak], top
 
 
 def restore(cell: np.ndarray, owner: np.ndarray, shapes: Shapes) -> np.ndarray:
