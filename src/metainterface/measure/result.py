@@ -453,7 +453,10 @@ class MeasureResult:
             target=p.target,
             error_bem=p.error_bem,
             error_design=p.error_design,
-            orientation=f"{r.orientation.describe()}, {math.degrees(r.lattice.theta):.3g} deg",
+            orientation=(
+                f"turned {math.degrees(r.lattice.theta):.3g} deg"
+                + (", mirrored (y reversed)" if r.orientation.mirrored else "")
+            ),
             lattice=self._axes(um),
             to_forces=None if self.friction is None else self.friction.forces,
         )

@@ -41,14 +41,22 @@ def measure_figure(
         ax.set_xlabel("x [um]")
         fig.colorbar(im, ax=ax, shrink=0.8)
     if orientation is not None:
-        axes[0].set_title(f"scan, levelled [um]\nfound: {orientation}", fontsize=9)
+        axes[0].set_title(f"scan, levelled [um]\n{orientation}", fontsize=9)
     if lattice is not None:  # the design's u (white) and v (red) axes where they lie
         o, ends = lattice
         for end, colour, name in ((ends[0], "w", "u"), (ends[1], "r", "v")):
             axes[0].annotate(
                 "", xy=end, xytext=o, arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.5}
             )
-            axes[0].text(*end, name, color=colour, fontsize=9)
+            axes[0].annotate(
+                name,
+                xy=end,
+                xytext=(3, 3),
+                textcoords="offset points",
+                color=colour,
+                fontsize=10,
+                fontweight="bold",
+            )
     diff = scan - designed
     lim = float(np.nanpercentile(np.abs(diff), 99)) or 1.0
     im = axes[2].imshow(diff, origin="lower", extent=extent, vmin=-lim, vmax=lim, cmap="RdBu_r")
