@@ -126,7 +126,7 @@ _HOMES: dict[str, str] = {
     "TrainConfig": "metainterface.surrogate.config",
     "ValidationResult": "metainterface.validation.result",
     "FeasibleScale": "metainterface.scaling.search",
-    "BemCheck": "metainterface.verify.check",
+    "BemCheck": "metainterface.verify.bemcheck",
     "Verify": "metainterface.verify.check",
     "measure": "metainterface.measure.run",
     "MeasureResult": "metainterface.measure.result",
@@ -163,7 +163,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from metainterface.sweep.folders import validate, write_result
     from metainterface.sweep.many import validate_many
     from metainterface.validation.result import ValidationResult
-    from metainterface.verify.check import BemCheck, Verify
+    from metainterface.verify.bemcheck import BemCheck
+    from metainterface.verify.check import Verify
 
 
 def __getattr__(name: str) -> Any:

@@ -45,7 +45,9 @@ def test_the_check_reports_the_bem_error_to_the_target(checked, unchecked):
     # uniform loads over the target's range, the target interpolated there
     t = checked.target
     np.testing.assert_allclose(b.p_star, t.p_star_max * np.arange(1, 5) / 4, rtol=1e-5)
-    assert not b.notes  # it reaches the end of the target (to 2e-6)
+    # it reaches the end of the target (to 2e-6); 96^2 is too coarse to estimate its own
+    # error (test_accuracy.py measures that on 192^2), and says so
+    assert len(b.notes) == 1 and "too coarse to estimate its own error" in b.notes[0]
     np.testing.assert_allclose(b.alpha_target, np.interp(b.p_star, t.p_star, t.alpha))
     assert checked.bem_error == pytest.approx(curve_error(b.alpha_bem, b.alpha_target))
     # the design meets this target in the model; the BEM reads the same cell within a few %
@@ -63,10 +65,17 @@ def test_the_correction_lowers_the_bem_error(corrected):
     assert before is not None and after.bem_error < before.bem_error
     assert 1 <= len(corrected.corrections) <= 2
     kept = [c.bem_error for c in corrected.corrections if c.accepted]
-    assert kept and kept[-1] == pytest.approx(after.bem_error)
     assert all(b < a for a, b in zip([before.bem_error, *kept], kept, strict=False))
+    # the iterations fit the loads k / K; the result's error is read at the interleaved
+    # (k - 1/2) / K, which none of them fitted
+    s = Verify(grid=96, loads=4)
+    fitted = bem_check(corrected.design, corrected.target, s)
+    assert kept and kept[-1] == pytest.approx(fitted.bem_error, rel=1e-6)
+    assert not before.held_out and not fitted.held_out and after.held_out
+    top = fitted.p_star[-1]
+    np.testing.assert_allclose(after.p_star, top * (np.arange(1, 5) - 0.5) / 4, rtol=1e-12)
     # the result is the corrected design: its BEM check and model error are its own
-    again = bem_check(corrected.design, corrected.target, Verify(grid=96, loads=4))
+    again = bem_check(corrected.design, corrected.target, s, held_out=True)
     assert again.bem_error == pytest.approx(after.bem_error, rel=1e-6)
     assert corrected.error > 1e-3  # it now misses the target in the model, on purpose
 
@@ -281,6 +290,8 @@ def test_cli_reports_each_correction_iteration(tmp_path, capsys):
     args += ["--correct-model", "independent"]
     assert main(args) == 0
     text = capsys.readouterr().out
-    assert "bilinear corrected in BEM:" in text and "iterations: " in text
+    assert "bilinear corrected in BEM:" in text and "iterations, at the loads they fit: " in text
+    # the error it reports is read between the loads the iterations fitted
+    assert "% at 4 loads between those" in text
     block = json.loads((tmp_path / "design.json").read_text())["bem_check"]
     assert len(block["corrections"]) == 3 and block["bem_error"] < block["uncorrected"]["bem_error"]

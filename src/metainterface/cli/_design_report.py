@@ -14,7 +14,7 @@ def table(args: argparse.Namespace, results: list) -> None:
     )
     checked = [r for r in results if r.bem is not None]
     if checked:
-        head += f"{'BEM':>11}{'BEM s':>8}"
+        head += f"{'BEM':>11}{'+-':>9}{'BEM s':>8}"
     if args.robust:
         head += f"{'made p50':>11}{'made p95':>11}"
     if args.z_step is not None:
@@ -32,7 +32,8 @@ def table(args: argparse.Namespace, results: list) -> None:
             q = r.printable
             line += f"{100 * q['error_before_snap']:>9.3g} %{100 * q['error_after_snap']:>9.3g} %"
         if r.bem is not None:
-            line += f"{100 * r.bem.bem_error:>9.3g} %{_bem_seconds(r):>8.1f}"
+            acc = "n/a" if r.bem.accuracy is None else f"{100 * r.bem.accuracy:.2g} %"
+            line += f"{100 * r.bem.bem_error:>9.3g} %{acc:>9}{_bem_seconds(r):>8.1f}"
         if r.forced:
             line += "  FORCED (out of reach)"
         print(line)
@@ -56,16 +57,19 @@ def table(args: argparse.Namespace, results: list) -> None:
 
 
 def _bem_seconds(r) -> float:
-    """Wall time of a result's BEM solves [s]: the check, and the correction's."""
-    return (r.bem_before or r.bem).seconds + sum(c.seconds for c in r.corrections)
+    """Wall time of a result's BEM solves [s]: the check, the correction's, and the
+    corrected design's check at the held-out loads."""
+    seconds = (r.bem_before or r.bem).seconds + sum(c.seconds for c in r.corrections)
+    return seconds + (r.bem.seconds if r.bem_before is not None and r.bem.held_out else 0.0)
 
 
 def _bem_legend(results: list) -> str:
     """What the BEM column is, in one line (with the corrections made)."""
     b = results[0].bem
+    grids = f"{b.grid}^2" + ("" if b.coarse_grid is None else f" and {b.coarse_grid}^2")
     line = (
-        f"BEM: the design solved in BEM ({b.engine}, {b.grid}^2, {b.p_star.size} loads), "
-        "its error to the target"
+        f"BEM: the design solved in BEM ({b.engine}, {grids}, {b.p_star.size} loads), "
+        "its error to the target; +-: the check's own accuracy (the grids' error)"
     )
     fixed = [r for r in results if r.bem_before is not None and r.bem is not r.bem_before]
     for r in fixed:
@@ -73,7 +77,8 @@ def _bem_legend(results: list) -> str:
             f"{100 * c.bem_error:.3g} %{'' if c.accepted else ' (not kept)'}" for c in r.corrections
         )
         line += (
-            f"; {r.target.name} corrected in BEM: {100 * r.bem_before.bem_error:.3g} % -> "
-            f"{100 * r.bem.bem_error:.3g} % (iterations: {steps})"
+            f"; {r.target.name} corrected in BEM: {r.bem_before.error_text()} -> "
+            f"(iterations, at the loads they fit: {steps}) {r.bem.error_text()} at "
+            f"{r.bem.p_star.size} loads between those"
         )
     return line

@@ -385,7 +385,7 @@ def run(args: argparse.Namespace) -> int:
         # agrees) from mechanics the model leaves out; the table's error is on the target's
         # grid, which weighs the loads otherwise
         print(
-            f"{r.target.name}: BEM error {100 * r.bem.bem_error:.3g} % is above "
+            f"{r.target.name}: BEM error {r.bem.error_text()} is above "
             f"--max-bem-error {100 * r.bem.max_error:g} %: the made surface will miss the "
             f"target (the model's error at the same loads: {100 * r.bem.model_error:.3g} %)"
         )

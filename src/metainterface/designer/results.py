@@ -212,6 +212,7 @@ class DesignResult(ReachCounts):
         if self.bem_before is not None:
             block["uncorrected"] = {
                 "bem_error": self.bem_before.bem_error,
+                "accuracy": self.bem_before.accuracy,
                 "model_error": self.bem_before.model_error,
             }
             block["corrections"] = [c.to_dict() for c in self.corrections]
@@ -270,9 +271,10 @@ class DesignResult(ReachCounts):
         forced = "FORCED (target unreachable), " if self.forced else ""
         if self.bem is not None:
             before = self.bem_before
-            fixed = "" if before is None else f", corrected from {_percent(before.bem_error)}"
+            fixed = "" if before is None else f", corrected from {before.error_text()}"
             flag = "" if self.bem.ok else f" (above {_percent(self.bem.max_error)})"
-            made += f", BEM error {_percent(self.bem.bem_error)}{flag} on {self.bem.grid}^2{fixed}"
+            where = " at loads the correction did not fit" if self.bem.held_out else ""
+            made += f", BEM error {self.bem.error_text()}{flag}{where} on {self.bem.grid}^2{fixed}"
         return (
             f"DesignResult({forced}target={self.target.name!r}, method={self.method!r}, "
             f"model={self.model.label!r}, error={_percent(self.error)}, "

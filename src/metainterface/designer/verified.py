@@ -26,8 +26,10 @@ def verified(
     robust: bool = False,
 ) -> DesignResult:
     """``r`` with its BEM check (``bem``) and, if ``settings`` asks for it, corrected: then
-    ``design`` and ``error`` are the corrected design's, ``bem_before`` the first check and
-    ``corrections`` every iteration."""
+    ``design`` and ``error`` are the corrected design's, ``bem_before`` the first check,
+    ``corrections`` every iteration, and ``bem`` the corrected design's check at the
+    interleaved loads the correction did not fit (its error there is the one it reports;
+    the error at the fitted loads is the last kept iteration's)."""
     check = bem_check(r.design, r.target, settings, r.model)
     if not settings.wants_correction(check):
         return replace(r, bem=check)
@@ -46,11 +48,12 @@ def verified(
     )
     if out.check is check:  # nothing kept: the design stays as it was
         return replace(r, bem=check, bem_before=check, corrections=out.corrections)
+    held_out = bem_check(out.design, r.target, settings, r.model, held_out=True)
     return replace(
         r,
         design=out.design,
         error=out.model_error,
-        bem=out.check,
+        bem=held_out,
         bem_before=check,
         corrections=out.corrections,
     )

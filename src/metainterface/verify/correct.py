@@ -13,7 +13,12 @@ BEM's own answer (output space mapping, Bandler et al., IEEE Trans. Microw. Theo
 defect correction, Stetter, Numer. Math. 29 (1978) 425). Each iteration re-refines from the
 current design with the refinement's polish, then solves the new design in BEM; it is kept
 only if its BEM error fell, otherwise the step s is halved (1, 1/2, 1/4, ...) from the same
-design. The loop stops on ``STOP_ERROR`` or once ``Verify.iterations`` BEM solves are spent.
+design. The loop stops once the BEM error is within the check's own accuracy (at least
+``STOP_ERROR``), once a kept step lowered it by no more than that accuracy (a further step
+would move it within what the check resolves), or once ``Verify.iterations`` BEM solves are
+spent. Each check solves the
+design at the check's loads k / K; the result's own error is read afterwards at the
+interleaved loads, which no iteration fitted (``designer.verified``).
 
 The model m of the correction (``Verify.inner``) need not be the one the design was made
 with: by default it is the interacting model, whose defect is a few times smaller and moves
@@ -55,8 +60,9 @@ from metainterface.physics.models import ForwardModel
 from metainterface.physics.registry import get_model
 from metainterface.verify.check import BemCheck, Verify, bem_check
 
-#: The correction stops once the BEM error is this low (0.1 %): about the BEM's own accuracy
-#: at the default grid, below which a further step corrects the grid, not the design.
+#: The correction stops once the BEM error is within the check's own accuracy
+#: (``BemCheck.accuracy``), below which a further step corrects the grid, not the design,
+#: and never below this (0.1 %), where the accuracy was not estimated or is finer.
 STOP_ERROR = 1e-3
 #: The first iteration makes a fresh design only where the re-refined one misses the shifted
 #: target by more than this (relative curve error in the correction's model).
@@ -212,6 +218,12 @@ def with_adhesion(inner: ForwardModel, model: ForwardModel) -> ForwardModel:
     return inner.with_adhesion(model.adhesion) if inner.takes_adhesion else model
 
 
+def stop_error(check: BemCheck) -> float:
+    """The BEM error the correction stops at: the check's own accuracy, at least
+    ``STOP_ERROR``."""
+    return max(STOP_ERROR, check.accuracy or 0.0)
+
+
 def correct(
     design: Design,
     target: Target,
@@ -244,7 +256,7 @@ def correct(
     step = 1.0
     done: list[Correction] = []
     for i in range(settings.iterations):
-        if best_check.bem_error <= STOP_ERROR:
+        if best_check.bem_error <= stop_error(best_check):
             break
         t0 = time.perf_counter()
         curve = shifted_target(target, best_check, step, best_inner)
@@ -271,8 +283,11 @@ def correct(
             )
         )
         if accepted:
+            gain = best_check.bem_error - cand_check.bem_error
             best, best_check = candidate, cand_check
             best_inner = inner_alpha(best, best_check)
+            if gain <= stop_error(cand_check):
+                break  # it moved the error by less than the check resolves: the next would too
         else:
             step /= 2
     return Corrected(
