@@ -33,9 +33,13 @@ def test_single_hertz_asperity_matches_the_closed_form(hertz):
     a = (3 * force / 4) ** (1 / 3)  # Hertz: a^3 = 3 F R / (4 E*)
     p0 = 3 * force / (2 * math.pi * a**2)  # peak pressure = 3/2 mean contact pressure
     a_bem = np.sqrt(hertz.alpha_bem * side**2 / math.pi)
-    np.testing.assert_allclose(a_bem, a, rtol=0.02)
-    np.testing.assert_allclose(hertz.p_max, p0, rtol=0.02)
-    np.testing.assert_allclose(hertz.alpha_bem, hertz.alpha_model, rtol=0.03)
+    # a / dx = 18-26 here: the sub-pixel area is within 0.6 % of pi a^2 from 22 steps on
+    # (test_subpixel_contact_area_against_sneddon), 1 % allowed at the first load's 18, so
+    # a within 0.5 %; the periodic images raise p0 by 0.13 % on 256^2 and 512^2 alike (not
+    # the grid's error): twice that
+    np.testing.assert_allclose(a_bem, a, rtol=0.005)
+    np.testing.assert_allclose(hertz.p_max, p0, rtol=0.003)
+    np.testing.assert_allclose(hertz.alpha_bem, hertz.alpha_model, rtol=0.01)
     assert hertz.p_star[-1] == pytest.approx(get_model().model_curve(HERTZ).p_star_max)
     assert (hertz.residual <= 1e-11).all()
 
@@ -186,7 +190,9 @@ def test_target_errors_measure_bem_and_model_against_the_design_target(hertz):
         return dataclasses.replace(hertz, design=dataclasses.replace(HERTZ, extras=extras))
 
     bem, model = with_target(alpha_hertz).target_errors()
-    assert model < 2e-3 and bem < 0.03  # the model is Hertz; the BEM is within its grid error
+    # the model is Hertz; the BEM's area is within 1 % of it at every load (above), so its
+    # curve error is below 1 %
+    assert model < 2e-3 and bem < 0.01
     bem_off, model_off = with_target(1.1 * alpha_hertz).target_errors()
     assert model_off == pytest.approx(1 / 11, rel=0.02)  # a target 10 % higher
     assert bem_off > bem
