@@ -158,7 +158,10 @@ def test_softplus_curve_converges_to_exact():
     g, h = random_designs(4, seed=6)
     exact = curve(g, h, S).alpha_hat
     errs = [float((curve(g, h, S, smooth=k).alpha_hat - exact).abs().max()) for k in (1e3, 1e5)]
-    assert errs[1] < errs[0] and errs[1] < 0.02
+    # the softplus rounds the bracket over a width ln 2 / kappa_s, 100x narrower at 1e5; a
+    # blunt (gamma = 4) asperity at engagement answers with area ~ delta^(1/2), so the worst
+    # point falls by its square root, 10x, at least (measured 65x: 9.8 % -> 0.15 %)
+    assert errs[1] < errs[0] / math.sqrt(100)
 
 
 def test_interp_holds_ends_and_duplicate_knots():
