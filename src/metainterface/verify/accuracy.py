@@ -4,12 +4,14 @@ A BEM grid of M points per side reads the contact area with an error that falls 
 grid spacing h = L / M as h^p (a pixel on each contact's edge): on held-out random cells
 (seed 5353, benchmarks/bench_check_accuracy.py --convergence) the norm of alpha_M -
 alpha_{M/2} fell 3.3-3.5x from (192, 384) to (384, 768), p = 1.7-1.8, and alpha at 384^2
-read 0.2-0.8 % above 768^2 at every load. Richardson's extrapolation from M and M / 2,
+read 0.28-0.40 % off 768^2 (benchmarks/results/verified.md). Richardson's extrapolation
+from M and M / 2,
 
     alpha_inf = alpha_M + (alpha_M - alpha_{M/2}) / (r^p - 1),   r = M / M_coarse,
 
-removes that leading term (from 192^2 and 384^2 it met the 768^2 solve to 0.07-0.12 % on
-those cells, about 768^2's own error); its accuracy is how far it moves over the orders
+removes that leading term (from 192^2 and 384^2 it met the 768^2 solve to 0.13-0.20 % on
+those cells, about 768^2's own error, which the same order puts at 0.12-0.17 %); its
+accuracy is how far it moves over the orders
 the grids may have, p in ``ORDER_RANGE`` (a range around the measured 1.7-1.8), measured
 as the check's curve error (norm relative to the target's):
 
