@@ -30,13 +30,15 @@ class Process:
     """How a printer makes a design. gamma_shift: added to every exponent; h_scale: the
     offsets scaled; flat_depth [m]: each tip cut flat this far below its apex (0: sharp);
     layer [m]: layer height (0: continuous); phase [m]: the layer levels' offset from the
-    datum (the tallest designed tip's apex)."""
+    datum (the tallest designed tip's apex); debris: a Gaussian lump (u, v, height, radius)
+    [m] stuck to the part (once, not in every cell)."""
 
     gamma_shift: float = 0.0
     h_scale: float = 1.0
     flat_depth: float = 0.0
     layer: float = 0.0
     phase: float = 0.0
+    debris: tuple[float, float, float, float] | None = None  # (u, v, height, radius) [m]
 
 
 def made_height(u: np.ndarray, v: np.ndarray, design: mi.Design, p: Process, radius: float):
@@ -58,6 +60,9 @@ def made_height(u: np.ndarray, v: np.ndarray, design: mi.Design, p: Process, rad
         z = np.minimum(z, apex - p.flat_depth)
     if p.layer > 0:
         z = p.phase + p.layer * np.floor((z - p.phase) / p.layer + 0.5)
+    if p.debris is not None:
+        u0, v0, height, width = p.debris
+        z = z + height * np.exp(-((u - u0) ** 2 + (v - v0) ** 2) / (2 * width**2))
     return z
 
 

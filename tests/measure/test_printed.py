@@ -137,3 +137,15 @@ def test_a_height_unit_slip_is_flagged(design):
         res = mi.measure(z * 1e3, design, radius=R, pixel_size=PIXEL, loads=2, progress=False)
     assert "about 99" in str(caught[0].message) and "factor 1000" in str(caught[0].message)
     assert any("height unit slip" in w for w in res.warnings())
+
+
+def test_extra_material_is_named(design):
+    # a 3 um lump (Delta_max is 5 um) on asperity 4's flank, in the one cell the scan shows
+    # whole; the scan shows asperity 4 in that cell only, so the measured cell keeps it
+    pitch = design.settings.cell_side * R / 3
+    lump = (1.5 * pitch + 0.25 * pitch, 1.5 * pitch, 3e-6, 15e-6)
+    z = _scan(design, Process(debris=lump), angle_deg=0.5, offset=(10.0, 10.0))
+    res = mi.measure(z, design, radius=R, pixel_size=PIXEL, loads=2, progress=False)
+    assert res.prediction.shapes.feature[4] == "extra material"
+    assert sum(bool(f) for f in res.prediction.shapes.feature) == 1
+    assert any("asperity 4: extra material" in w for w in res.warnings())
