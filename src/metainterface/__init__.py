@@ -41,9 +41,11 @@ Looking at a design
     view (an interactive, self-contained HTML page; the [view] extra), DesignResult.figure
 The part as made
     measure, MeasureResult
-    (a scan of the made part in, registered to its design, every asperity fitted, its law
-    predicted by BEM; .compensate(): the geometry to print next so that the made part
-    meets the target; the [measure] extra reads the scan)
+    (a scan of the made part in, in any orientation, registered to its design, every
+    asperity fitted, layer steps and cut tips found; its law predicted by BEM on the
+    measured cell, with the BEM's own accuracy; .compensate(): the geometry to print next
+    so that the made part meets the target, modelled on the process and checked in BEM;
+    .report(): the summary on screen; the [measure] extra reads the scan)
 Manufacturing errors
     tolerance, ToleranceResult (the band of alpha(P*) and the error under height, shape and
     scale errors), min_radius, PrinterSizing (the smallest R for a printer's height error);
