@@ -20,6 +20,7 @@ if it beats the design itself printed as it is.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -30,6 +31,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.measure.predict import (
     ERROR_POINTS,
     bem_error,
+    coarse_grid,
     curve_errors,
     loads_over,
     model_alpha,
@@ -45,7 +47,15 @@ from metainterface.physics.registry import get_model
 #: Steps of the refinement with the map inside.
 REFINE_STEPS = 150
 #: Rounds of the BEM correction after the family's own.
-ROUNDS = 2
+ROUNDS = 3
+#: Each round refines towards the target over the BEM/family ratio to these powers (the
+#: full correction, and half of it where the full one overshoots).
+DAMPING = (1.0, 0.5)
+
+
+def solves(rounds: int = ROUNDS) -> int:
+    """The BEM solves ``compensate`` makes (for a progress bar)."""
+    return 2 + 2 + rounds * len(DAMPING)
 
 
 @dataclass(frozen=True)
@@ -140,20 +150,37 @@ def process_from(
     pairs: list[tuple[Design, Registration, Shapes]], z_step: float | None = None
 ) -> Process:
     """The process from (design, registration, shapes) triples: the map (``fit_map``), the
-    flat depth (the median, over the flat tips seen, of the fitted apex less the plateau)
+    flat depth (``_flat_depth``, from the flat tips seen: the fitted apex and the plateau)
     and the layer levels of the first scan that shows them (step ``z_step`` [R] if given)."""
     pmap = fit_map([(d, r) for d, r, _ in pairs])
-    depths = []
+    terraces = next((sh.terraces for _, _, sh in pairs if sh.terraces is not None), None)
+    apex, plateau = [], []
     for _, reg, shapes in pairs:
         flat = (shapes.flat_radius > 0) & (reg.seen > 0)
-        depths.extend((-reg.h[flat] - shapes.plateau[flat]).tolist())
-    depth = max(0.0, float(np.median(depths))) if depths else 0.0
-    terraces = next((sh.terraces for _, _, sh in pairs if sh.terraces is not None), None)
+        apex.extend((-reg.h[flat]).tolist())
+        plateau.extend(shapes.plateau[flat].tolist())
+    depth = _flat_depth(np.array(apex), np.array(plateau), terraces)
     if z_step is not None and terraces is not None and not terraces.given:
         terraces = Terraces(z_step, terraces.phase, terraces.coherence, given=True)
     elif z_step is not None and terraces is None:
         terraces = Terraces(z_step, 0.0, 0.0, given=True)
     return Process(pmap=pmap, flat_depth=depth, terraces=terraces)
+
+
+def _flat_depth(apex: np.ndarray, plateau: np.ndarray, terraces: Terraces | None) -> float:
+    """The depth [R] the tips are cut below their apex (N,) to their plateaus (N,). On
+    layers a plateau is the level nearest apex - depth, so each says depth only to within
+    a step; the depths that put every plateau on its level are an interval, whose middle is
+    kept. Without layers, the median of apex - plateau."""
+    if apex.size == 0:
+        return 0.0
+    cut = apex - plateau
+    if terraces is None:
+        return max(0.0, float(np.median(cut)))
+    trial = np.linspace(0.0, float(cut.max()) + terraces.step, 801)
+    miss = np.abs(on_levels(apex[None] - trial[:, None], terraces) - plateau[None]).sum(1)
+    best = trial[miss <= miss.min() + 1e-3 * terraces.step]
+    return float(np.median(best))
 
 
 @dataclass(frozen=True)
@@ -197,11 +224,14 @@ def compensate(
     engine: Any = None,
     device: Any = "auto",
     radius_m: float | None = None,
+    report: Callable[[int], Any] | None = None,
 ) -> Compensation:
     """Pre-distort ``design`` for ``process`` (module docstring), each candidate judged by
     the BEM of its predicted made cell on grid x grid at ``loads`` loads over the target's
-    range. radius_m: R [m], recorded in the printed design file (so that ``export`` need not
-    be told it again)."""
+    range (the candidates on a grid half as fine, the one kept and the design itself on the
+    full grid). radius_m: R [m], recorded in the printed design file (so that ``export``
+    need not be told it again). report: called with 1 after each BEM solve
+    (``solves(rounds)`` of them)."""
     if isinstance(process, PrintMap):
         process = Process(pmap=process)
     pmap = process.pmap
@@ -210,24 +240,31 @@ def compensate(
     p = loads_over(target, loads)
     h_design = design.h - design.h.min()
 
-    def judged(g: np.ndarray, h: np.ndarray) -> tuple[float, np.ndarray]:
+    loop_grid = coarse_grid(grid, s.n_side)
+
+    def judged(g: np.ndarray, h: np.ndarray, m: int) -> tuple[float, np.ndarray]:
         path = solve_cell(
-            process.made_cell(g, h, design, grid), design, p, engine=engine, device=device
+            process.made_cell(g, h, design, m), design, p, engine=engine, device=device
         )
+        if report is not None:
+            report(1)
         return float(bem_error(p, path.alpha, target)[0]), path.alpha
 
-    before, a_before = judged(design.gamma, h_design)
-    # the family's own correction: the map's inverse, refined with the map inside
+    before, a_before = judged(design.gamma, h_design, grid)
+    # the family's own correction: the map's inverse, as it is and refined with the map inside
     g0 = np.clip(design.gamma - pmap.gamma_shift - pmap.gamma_bias, s.gamma_min, s.gamma_max)
     h0 = (h_design - pmap.h_bias) / pmap.h_scale
     h0 = h0 - h0.min()
-    g, h = _refine(g0, h0, pmap, design, target, model, steps)
+    candidates = [(g0, h0), _refine(g0, h0, pmap, design, target, model, steps)]
     best: tuple[float, np.ndarray, np.ndarray, np.ndarray] | None = None
     p_t, a_t = target
+    # candidates judged on the coarse grid (a quarter of the cost; its discretisation is
+    # common to them all), the best one again on the full grid
     for i in range(rounds + 1):
-        err, alpha = judged(g, h)
-        if best is None or err < best[0]:
-            best = (err, g, h, alpha)
+        for g, h in candidates:
+            err, alpha = judged(g, h, loop_grid)
+            if best is None or err < best[0]:
+                best = (err, g, h, alpha)
         if i == rounds:
             break
         # the BEM over the family at the loads: the part of the curve the family cannot say
@@ -235,9 +272,14 @@ def compensate(
         fam, _ = model_alpha(gm[None], hm[None], design, p, model)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(fam[0] > 0, best[3] / fam[0], 1.0)
-        ratio = np.clip(np.nan_to_num(ratio, nan=1.0, posinf=1.0), 0.2, 5.0)
-        corrected = (p_t, a_t / np.interp(p_t, p, ratio))
-        g, h = _refine(best[1], best[2], pmap, design, corrected, model, steps)
+        ratio = np.interp(p_t, p, np.clip(np.nan_to_num(ratio, nan=1.0, posinf=1.0), 0.2, 5.0))
+        candidates = [
+            _refine(best[1], best[2], pmap, design, (p_t, a_t / ratio**lam), model, steps)
+            for lam in DAMPING
+        ]
+    assert best is not None
+    after, a_after = judged(best[1], best[2], grid)
+    best = (after, best[1], best[2], a_after)
     assert best is not None
     after, g1, h1, a_after = best
     gm, hm = pmap.made(g1, h1)
@@ -268,6 +310,7 @@ def compensate(
         "predicted_made_error_before": before,
         "predicted_made_error_after": after,
         "predicted_by": f"BEM of the predicted made cell, {grid}^2, {loads} loads",
+        "candidates_judged_on": f"{loop_grid}^2",
         "family_error_after": float(family[0]),
         "process": process.to_dict(radius_m if radius_m is not None else 1.0),
         "process_units": "um" if radius_m is not None else "units of R (no radius given)",

@@ -96,8 +96,9 @@ def measured_cell(scan: Scan, reg: Registration, design: Design, grid: int) -> M
     seen = count > 0
     heights = fitted.copy()
     if seen.any():
-        mean = total[seen] / count[seen]
-        heights[seen] = mean - np.median(mean - fitted[seen])  # onto the fitted level
+        # onto the made heights' frame by the registration's own offset (not by a median
+        # against the fitted surface: cut tips and layers would bias that)
+        heights[seen] = total[seen] / count[seen] + reg.level
     return MeasuredCell(
         heights=heights, fitted=fitted, spacing=spacing, copies=count, filled=float(1 - seen.mean())
     )

@@ -55,6 +55,7 @@ class Registration:
     shift: np.ndarray
     tip_radius: np.ndarray
     tip_radius_design: np.ndarray
+    level: float = 0.0
 
 
 def check_size(scan: Scan, design: Design) -> float:
@@ -169,4 +170,5 @@ def _summarise(
         shift=shift,
         tip_radius=mean(fits.tip_radius, np.inf),
         tip_radius_design=mean(fits.tip_radius_design, np.inf),
+        level=float(offset),
     )

@@ -10,7 +10,7 @@ from typing import Any
 
 from metainterface.errors import MetainterfaceError
 from metainterface.measure.compensate import compensate as compensate_design
-from metainterface.measure.compensate import process_from
+from metainterface.measure.compensate import process_from, solves
 from metainterface.measure.predict import predict, shapes_of
 from metainterface.measure.register import register
 from metainterface.measure.result import Friction, MeasureResult
@@ -127,15 +127,24 @@ def measure(
             other = as_scan(other_scan, radius=radius, pixel_size=pixel_size, **read)
             other_reg = register(other, d)
             triples.append((d, other_reg, shapes_of(other_reg.scan, other_reg, d, z_step=z)[1]))
-        comp = compensate_design(
-            design,
-            process_from(triples, z_step=z),
-            model=model,
-            grid=pred.grid,
-            loads=loads,
-            device=device,
-            radius_m=s.radius_m,
-        )
+        with contextlib.ExitStack() as stack:
+            report = None
+            if progress:
+                from tqdm.auto import tqdm
+
+                total = solves()
+                bar = stack.enter_context(tqdm(total=total, desc="correction", unit="BEM"))
+                report = bar.update
+            comp = compensate_design(
+                design,
+                process_from(triples, z_step=z),
+                model=model,
+                grid=pred.grid,
+                loads=loads,
+                device=device,
+                radius_m=s.radius_m,
+                report=report,
+            )
         result = dataclasses.replace(result, compensation=comp)
 
     if out is not None:

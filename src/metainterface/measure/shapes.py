@@ -34,16 +34,24 @@ from metainterface.physics.cell import Design
 MIN_COHERENCE = 0.5
 #: Share of the top's points, the flattest, on which terraces are looked for.
 TREAD_SHARE = 0.3
-#: Smallest layer step looked for [units of Delta_max] (finer ones are no printer's).
-MIN_STEP = 0.05
+#: Smallest layer step looked for [units of Delta_max]: finer ones would be a tenth of the
+#: design's height range, and a design's own offsets on a round grid read as such steps.
+MIN_STEP = 0.1
+#: Smallest levels' coherence on the asperities' flanks, below their top level: layers show
+#: there too (0.40-0.98 on the tuning prints), a few flat tops at round heights do not
+#: (0.05-0.16).
+MIN_FLANK_COHERENCE = 0.3
 #: Fewest tread points below an asperity's top level for its flank to count.
 MIN_LEVEL_POINTS = 20
 #: Fewest tread points to read layers from.
 MIN_TREAD_POINTS = 200
 #: Depth of the top looked at [units of Delta_max]: where contact happens.
 TOP_DEPTH = 2.0
-#: Cell noise [units of Delta_max] below which the measured cell is left as it is.
-NOISE_TOLERANCE = 0.005
+#: Cell noise [units of Delta_max] below which the measured cell is left as it is: 0.02 um
+#: of cell noise at R = 0.5 mm read the first contacts' area 2.5 % low against the exact
+#: cell (benchmarks/bench_measure.py); the Gaussian that takes it off is at most one grid
+#: step, half a scan pixel at the default grid, so nothing the scan resolves is lost.
+NOISE_TOLERANCE = 0.0005
 #: A flat tip: its plateau's radius at least this many scan pixels, and this many times the
 #: fitted power law's own within the same height band.
 FLAT_PIXELS = 2.0
@@ -127,7 +135,8 @@ def find_terraces(
     """Layer levels of a measured cell (M, M) [R] (module docstring), or None. step: the
     layer step when known (``--z-step``): only its phase is read. owner: (M, M) asperity
     index: the levels must show on most asperities' flanks too, below their top level, with
-    a coherence of ``MIN_COHERENCE`` (a few flat tops at round heights are no layers)."""
+    a coherence of ``MIN_FLANK_COHERENCE`` (a few flat tops at round heights are no
+    layers)."""
     from scipy import ndimage
 
     def spread(z: np.ndarray) -> np.ndarray:
@@ -184,7 +193,7 @@ def find_terraces(
     terraces = Terraces(float(step), _phase(c, float(step)), float(abs(c)))
     if (
         owner_flat is not None
-        and _flank_coherence(cell[flat], owner_flat, terraces) < MIN_COHERENCE
+        and _flank_coherence(cell[flat], owner_flat, terraces) < MIN_FLANK_COHERENCE
     ):
         return None
     return terraces
