@@ -33,6 +33,10 @@ def law(folder: Path) -> Path:
     return path
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = ""
+
+
 def main() -> None:
     csv = law(Path(tempfile.mkdtemp()))
     start = time.perf_counter()

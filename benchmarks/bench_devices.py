@@ -128,9 +128,13 @@ def machine(device: str) -> str:
     return f"{name}, {torch.get_num_threads()} torch thread(s)"
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--quick"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true", help="5k samples, 2 epochs, K <= 10")
+    ap.add_argument("--quick", action="store_true", help="2k samples, 1 epoch, K = 1")
     ap.add_argument("--samples", type=int, default=100_000, help="dataset size (100000)")
     ap.add_argument("--epochs", type=int, default=3, help="epochs measured (3)")
     ap.add_argument("--full-training", action="store_true", help="run all 500 epochs")
@@ -139,7 +143,7 @@ def main() -> None:
     ap.add_argument("--out", help="write the markdown table here")
     args = ap.parse_args()
     if args.quick:
-        args.samples, args.epochs, args.max_k = 5000, 2, 10
+        args.samples, args.epochs, args.max_k = 2000, 1, 1
     tune_allocator()
     columns: dict[str, dict[str, str]] = {}
     where: dict[str, str] = {}

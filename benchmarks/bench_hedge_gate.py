@@ -23,6 +23,9 @@ import metainterface as mi
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_design import realisable_targets
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--gates 1e-3 --targets 1"
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
