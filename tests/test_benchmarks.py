@@ -43,7 +43,7 @@ def test_runner_lists_every_benchmark_with_a_quick_mode():
 
 def test_a_script_without_quick_is_refused(tmp_path):
     (tmp_path / "bench_x.py").write_text('"""X."""\n\ndef main():\n    pass\n')
-    with pytest.raises(ValueError, match="bench_x.py: QUICK"):
+    with pytest.raises(ValueError, match=r"bench_x\.py: QUICK"):
         runner.discover(tmp_path)
 
 
