@@ -29,6 +29,19 @@ def register(sub: argparse._SubParsersAction) -> None:
         "target reported beside the model's; exit status 3 when a design's BEM error is above "
         "--max-bem-error (the files are written all the same), 2 on bad input.",
     )
+    _target_arguments(p)
+    _unit_arguments(p)
+    _output_arguments(p)
+    _method_arguments(p)
+    _space_arguments(p)
+    _manufacturing_arguments(p)
+    _limit_arguments(p)
+    _check_arguments(p)
+    p.set_defaults(func=run)
+
+
+def _target_arguments(p: argparse.ArgumentParser) -> None:
+    """`design`'s targets: built-in names, CSV files of alpha(P*) or of friction, the fit."""
     src = p.add_argument_group("targets (one or more)")
     src.add_argument(
         "--target",
@@ -59,6 +72,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "cross-validation): auto (default) fits rows with scatter, repeated or unsorted loads, "
         "or 5-9 rows; the fit is drawn in friction_fit.png",
     )
+
+
+def _unit_arguments(p: argparse.ArgumentParser) -> None:
+    """`design`'s options: the physical units of a friction law or a physical block."""
     phys = p.add_argument_group("physical units (with --friction-csv, or for a physical block)")
     phys.add_argument(
         "--shear-strength",
@@ -80,6 +97,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--modulus, --shear-strength may be free)",
     )
     phys.add_argument("--total-force", help="total normal force, e.g. 10N (number of cells)")
+
+
+def _output_arguments(p: argparse.ArgumentParser) -> None:
+    """`design`'s options: what is written, and where."""
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument(
         "--full-target",
@@ -91,6 +112,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="also write view.html, an interactive page of each design (needs the [view] extra)",
     )
+
+
+def _method_arguments(p: argparse.ArgumentParser) -> None:
+    """`design`'s method and effort: refinement, hedges, fallback, forward model."""
     p.add_argument("--method", choices=METHOD_NAMES, default="surrogate")
     p.add_argument("--refine", choices=("lbfgs", "none"), default="lbfgs")
     p.add_argument(
@@ -123,6 +148,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=DEFAULT_MODEL,
         help="forward model to refine and measure with (default: the paper's independent one)",
     )
+
+
+def _space_arguments(p: argparse.ArgumentParser) -> None:
+    """`design`'s options: the design space: the cell's asperities and bounds."""
     space = p.add_argument_group(
         "design space (default: the paper's cell, which the shipped surrogate was trained for; "
         "another cell is designed by multistart)"
@@ -131,6 +160,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     space.add_argument("--gamma-min", type=float, help="smallest shape exponent (1.8)")
     space.add_argument("--gamma-max", type=float, help="largest shape exponent (4.0)")
     space.add_argument("--delta-max", type=float, help="largest indentation in units of R (0.02)")
+
+
+def _manufacturing_arguments(p: argparse.ArgumentParser) -> None:
+    """`design`'s options: manufacturing errors: robust design and the printer's layer height."""
     made = p.add_argument_group(
         "manufacturing (lengths with a unit need --radius; a plain number is in units of R, "
         "and Delta_max is 0.02 R)"
@@ -156,6 +189,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="printer layer height, e.g. 1um: heights snapped to its multiples, the shapes "
         "re-refined; the error before and after is reported",
     )
+
+
+def _limit_arguments(p: argparse.ArgumentParser) -> None:
+    """`design`'s options: forced designs, the pressure limit and the device."""
     p.add_argument(
         "--force",
         action="store_true",
@@ -167,6 +204,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="peak contact pressure limit: p/E* (number) or a stress with --modulus",
     )
     add_device(p)
+
+
+def _check_arguments(p: argparse.ArgumentParser) -> None:
+    """`design`'s options: the BEM check, its correction and its trust threshold."""
     check = p.add_argument_group(
         "BEM check (on by default; docs: concepts/verification)",
         "each design is solved in BEM at --verify-loads loads over the target's range and "
@@ -221,7 +262,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="contact solver of the check: torch (default; CPU threads or a GPU) or tamaas "
         "(the [bem] extra, the reference)",
     )
-    p.set_defaults(func=run)
 
 
 def _targets(args: argparse.Namespace) -> list:
