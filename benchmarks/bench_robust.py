@@ -70,12 +70,15 @@ def main() -> None:
     targets += realisable_targets(args.targets) if args.targets else []
     verify = {"verify": False} if args.no_verify else {}
     mi.design(targets[:1], **verify)  # warm-up (imports, model load)
-    kw = dict(sigma_h=args.sigma_h, sigma_gamma=args.sigma_gamma, **verify)
     t0 = time.perf_counter()
     nominal = mi.design(targets, **verify)
     t_nom = time.perf_counter() - t0
     t0 = time.perf_counter()
-    robust = mi.design(targets, robust=mi.Robust(samples=args.copies), **kw)
+    robust = mi.design(
+        targets,
+        robust=mi.Robust(samples=args.copies, sigma_h=args.sigma_h, sigma_gamma=args.sigma_gamma),
+        **verify,
+    )
     t_rob = time.perf_counter() - t0
     pert = Perturbation.draw(
         9, args.samples, 12345, sigma_h=args.sigma_h, sigma_gamma=args.sigma_gamma

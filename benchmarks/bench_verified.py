@@ -176,7 +176,7 @@ def summary(rows: list[dict], grids: list[int]) -> list[str]:
 
 
 # Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
-QUICK = "--quick"
+QUICK = "--quick --grids 96 --loads 4 --n-random 1 --no-analytic --only saturating --iterations 1"
 
 
 def main() -> None:
