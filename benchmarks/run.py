@@ -138,6 +138,35 @@ def command(bench: Benchmark, args: list[str], env: dict[str, str]) -> str:
     return (prefix + " " if prefix else "") + shlex.join(words)
 
 
+def _spawn(
+    argv: list[str], env: dict[str, str], timeout: float
+) -> tuple[int | None, str, str, float | None]:
+    """Run ``argv`` from the repository's root: (exit code or None when killed at
+    ``timeout``, stdout, stderr, CPU seconds of it and its waited-for children)."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        proc = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=out, stderr=err, text=True)
+        deadline = time.monotonic() + timeout
+        code = cpu = None
+        while True:
+            pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
+            if pid:
+                code = os.waitstatus_to_exitcode(status)
+                cpu = usage.ru_utime + usage.ru_stime
+                proc.returncode = code  # reaped here: Popen must not wait for it again
+                break
+            if time.monotonic() > deadline:
+                proc.kill()
+                proc.wait()
+                break
+            time.sleep(0.05)
+        out.seek(0)
+        err.seek(0)
+        stdout, stderr = out.read(), err.read()
+    if code is None:
+        stderr += f"\ntimed out after {timeout:g} s"
+    return code, stdout, stderr, cpu
+
+
 def run_one(bench: Benchmark, args: list[str], quick: bool, out: Path, timeout: float) -> dict:
     """Run one benchmark in a fresh process and write its record to ``out/NAME.json``."""
     env = dict(QUICK_ENV) if quick else {}
@@ -146,20 +175,7 @@ def run_one(bench: Benchmark, args: list[str], quick: bool, out: Path, timeout: 
     full_env["PYTHONPATH"] = src + os.pathsep + full_env.get("PYTHONPATH", "")
     started = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
     t0 = time.perf_counter()
-    try:
-        proc = subprocess.run(
-            [sys.executable, str(bench.path), *args],
-            cwd=ROOT,
-            env=full_env,
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-        )
-        code, stdout, stderr = proc.returncode, proc.stdout, proc.stderr
-    except subprocess.TimeoutExpired as exc:
-        code = None
-        stdout = exc.stdout.decode() if isinstance(exc.stdout, bytes) else (exc.stdout or "")
-        stderr = f"timed out after {timeout:g} s"
+    code, stdout, stderr, cpu = _spawn([sys.executable, str(bench.path), *args], full_env, timeout)
     record = {
         "benchmark": bench.name,
         "summary": bench.summary,
@@ -167,6 +183,9 @@ def run_one(bench: Benchmark, args: list[str], quick: bool, out: Path, timeout: 
         "quick": quick,
         "returncode": code,
         "wall_s": round(time.perf_counter() - t0, 2),
+        # user + system seconds of the benchmark and the processes it waited for: what a
+        # busy machine changes least (wall time there grows with the load average)
+        "cpu_s": None if cpu is None else round(cpu, 2),
         "started_utc": started,
         "machine": machine(),
         "git_commit": _git("rev-parse", "HEAD"),
@@ -208,7 +227,8 @@ def page(runs: Path) -> str:
             rec["summary"],
             "",
             f"Command: `{rec['command']}`  ",
-            f"Run {rec['started_utc']}, {rec['wall_s']} s, {status}, commit "
+            f"Run {rec['started_utc']}, {rec['wall_s']} s ({rec.get('cpu_s')} s CPU), {status}, "
+            "commit "
             f"{(rec['git_commit'] or '?')[:10]}{' (modified)' if rec['git_dirty'] else ''}  ",
             f"Machine: {m['cores']} cores ({m['cores_usable']} usable), {m['cpu_model']}, "
             f"load {', '.join(f'{x:.1f}' for x in m['load_average'] or [])}; "
@@ -265,14 +285,19 @@ def main(argv: list[str] | None = None) -> int:
             args = [a.replace("{tmp}", tmp) for a in args]
             rec = run_one(bench, args, opts.quick, out, timeout)
         ok = "ok" if rec["returncode"] == 0 else f"FAILED (exit {rec['returncode']})"
-        print(f"{bench.name:32s} {rec['wall_s']:7.1f} s  {ok}", flush=True)
+        cpu = "" if rec["cpu_s"] is None else f" ({rec['cpu_s']:.1f} s CPU)"
+        print(f"{bench.name:32s} {rec['wall_s']:7.1f} s{cpu}  {ok}", flush=True)
         return rec
 
     t0 = time.perf_counter()
     with ThreadPoolExecutor(max(1, opts.jobs)) as pool:
         records = list(pool.map(one, chosen))
     failed = [r for r in records if r["returncode"] != 0]
-    print(f"{len(records)} benchmarks in {time.perf_counter() - t0:.0f} s, records in {out}")
+    cpu = sum(r["cpu_s"] or 0.0 for r in records)
+    print(
+        f"{len(records)} benchmarks in {time.perf_counter() - t0:.0f} s ({cpu:.0f} s CPU), "
+        f"records in {out}"
+    )
     for rec in failed:
         print(f"\n--- {rec['benchmark']} failed: {rec['command']}\n{rec['stderr_tail']}")
     return 1 if failed else 0

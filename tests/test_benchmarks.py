@@ -70,6 +70,8 @@ def test_quick_run_is_recorded_with_command_and_machine(tmp_path):
 
     assert m["torch"] == torch.__version__
     assert rec["wall_s"] > 0 and rec["started_utc"].endswith("+00:00")
+    # the CPU seconds of the process (it imports torch and runs 40 L-BFGS iterations)
+    assert rec["cpu_s"] > 0
     page = runner.page(out)
     assert "## bench_lbfgs" in page and f"`{rec['command']}`" in page
 
@@ -94,3 +96,15 @@ def test_results_pages_name_benchmarks_that_exist():
         )
         assert named, f"{page.name} names no benchmark command"
         assert named - {"run"} <= scripts, f"{page.name}: {sorted(named - scripts - {'run'})}"
+
+
+def test_a_benchmark_past_its_timeout_is_killed_and_recorded_as_failed(tmp_path):
+    argv = ["run", "--quick", "bench_lbfgs", "--timeout", "0.5", "--out", str(tmp_path)]
+    done = subprocess.run(
+        [sys.executable, str(BENCH / "run.py"), *argv],
+        capture_output=True,
+        text=True,
+    )
+    rec = json.loads((tmp_path / "bench_lbfgs.json").read_text())
+    assert done.returncode == 1 and rec["returncode"] is None and rec["cpu_s"] is None
+    assert "timed out after 0.5 s" in rec["stderr_tail"] and rec["wall_s"] < 30
