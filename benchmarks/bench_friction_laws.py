@@ -161,7 +161,7 @@ def figure(targets: list[mi.Target], fams: list[str], alone: str, path: str) -> 
 
 
 # Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
-QUICK = "--laws 2 --held-out 2 --cells 2"
+QUICK = "--laws 4 --held-out 2 --cells 2"
 
 
 def main() -> None:
