@@ -1,6 +1,6 @@
-"""A sweep over many designs (:func:`validate_many`): each design's folder written whole
-(built under a hidden name, then renamed) and ``summary.csv``, one row per finished design,
-after each design; a finished design with the same request is kept, not solved again."""
+"""A BEM sweep over many designs (:func:`validate_many`): the designs listed and planned,
+finished ones with the same request kept, the rest solved on local processes, a Dask
+cluster or an executor (their folders and summary.csv written by ``sweep.collect``)."""
 
 from __future__ import annotations
 
