@@ -107,12 +107,12 @@ def main() -> None:
         "| robust: design error | made median | made p95 |",
         "|---|---|---|---|---|---|---|",
     ]
-    for i in range(len(mi.Target.builtins())):
+    for i in range(len(names)):
         lines.append(
             f"| {targets[i].name} | {pc(nominal[i].error)} | {pc(med_nom[i])} | "
             f"{pc(p95_nom[i])} | {pc(robust[i].error)} | {pc(med_rob[i])} | {pc(p95_rob[i])} |"
         )
-    rnd = slice(len(mi.Target.builtins()), None)
+    rnd = slice(len(names), None)
     if args.targets:
         en = np.array([r.error for r in nominal[rnd]])
         er = np.array([r.error for r in robust[rnd]])
