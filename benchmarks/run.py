@@ -174,6 +174,9 @@ def run_one(bench: Benchmark, args: list[str], quick: bool, out: Path, timeout: 
     src = str(ROOT / "src")
     full_env["PYTHONPATH"] = src + os.pathsep + full_env.get("PYTHONPATH", "")
     started = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
+    # the source tree as the run starts (a checkout during a long run must not relabel it)
+    commit = _git("rev-parse", "HEAD")
+    dirty = bool(_git("status", "--porcelain", "--", "src", "benchmarks"))
     t0 = time.perf_counter()
     code, stdout, stderr, cpu = _spawn([sys.executable, str(bench.path), *args], full_env, timeout)
     record = {
@@ -188,8 +191,8 @@ def run_one(bench: Benchmark, args: list[str], quick: bool, out: Path, timeout: 
         "cpu_s": None if cpu is None else round(cpu, 2),
         "started_utc": started,
         "machine": machine(),
-        "git_commit": _git("rev-parse", "HEAD"),
-        "git_dirty": bool(_git("status", "--porcelain", "--", "src", "benchmarks")),
+        "git_commit": commit,
+        "git_dirty": dirty,
         "stdout": stdout,
         "stderr_tail": stderr[-4000:],
     }
