@@ -173,6 +173,9 @@ def run_one(bench: Benchmark, args: list[str], quick: bool, out: Path, timeout: 
     full_env = {**os.environ, **env}
     src = str(ROOT / "src")
     full_env["PYTHONPATH"] = src + os.pathsep + full_env.get("PYTHONPATH", "")
+    # the environment's console scripts (`metainterface`) first, as in an activated venv
+    bindir = os.path.dirname(sys.executable)
+    full_env["PATH"] = bindir + os.pathsep + full_env.get("PATH", "")
     started = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
     # the source tree as the run starts (a checkout during a long run must not relabel it)
     commit = _git("rev-parse", "HEAD")
