@@ -92,6 +92,10 @@ def cell(grid: int) -> None:
     )
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--grids 48 --design-grid 48"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--grids", type=int, nargs="*", default=[128, 256])

@@ -9,7 +9,7 @@ the adhesive network's where weights/surrogate_adhesive.pt is there, scored with
 adhesive model) and with it. No BEM check (verify=False).
 
     PYTHONPATH=src python benchmarks/bench_adhesive_design.py [--targets 8]
-        [--models adhesive plain] [--alone MODEL_FILE [--hedge 4]]
+        [--models adhesive plain] [--alone MODEL_FILE [--hedge 4]] [--zero-shot]
 
 ``--alone FILE``: that network alone, zero-shot (no refinement, no fallback), ``--hedge`` its
 hedges (design's default 8).
@@ -41,6 +41,10 @@ def target(model, g, h, s, name):
     return mi.Target(p_star=p, alpha=a, name=name)
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--targets 1 --models adhesive --zero-shot"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--targets", type=int, default=8)
@@ -49,6 +53,7 @@ def main() -> None:
     )
     parser.add_argument("--alone", metavar="MODEL_FILE", help="this network alone, zero-shot")
     parser.add_argument("--hedge", type=int, help="with --alone: its hedges")
+    parser.add_argument("--zero-shot", action="store_true", help="without the refined designs")
     args = parser.parse_args()
     if args.alone:
         hedge = {} if args.hedge is None else {"hedge": args.hedge}
@@ -56,7 +61,8 @@ def main() -> None:
             False: mi.Effort(seed=0, refine=False, fallback=0, surrogate=args.alone, **hedge)
         }
     else:
-        efforts = {refine: mi.Effort(refine=refine, seed=0) for refine in (False, True)}
+        refines = (False,) if args.zero_shot else (False, True)
+        efforts = {refine: mi.Effort(refine=refine, seed=0) for refine in refines}
     s = CellSettings()
     rows = {}
     models = {"adhesive": mi.Independent(adhesion=W), "plain": mi.Independent()}

@@ -6,7 +6,7 @@ The law: a held-back adhesive cell's loading curve (``metainterface._testing``, 
 R = 0.5 mm), tau = 0.3 MPa over 4 cm^2. Designed by the default path (``verify=False``),
 then ``bem_check`` with ``Verify(grid=G, loads=12, correct=False)``.
 
-    PYTHONPATH=src python benchmarks/bench_adhesive_offset_check.py [--grids 96 192]
+    PYTHONPATH=src python benchmarks/bench_adhesive_offset_check.py [--grids 96 192] [--zero-shot]
 """
 
 from __future__ import annotations
@@ -26,9 +26,14 @@ from metainterface.verify.check import bem_check
 E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--grids 48 --zero-shot"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--grids", type=int, nargs="+", default=[96, 192])
+    ap.add_argument("--zero-shot", action="store_true", help="the design before refinement")
     args = ap.parse_args()
     p, a = adhesive_cell_curve(W_J / (E * R), seed=11, rows=24)
     path = Path(tempfile.mkdtemp()) / "pdms.csv"
@@ -41,7 +46,8 @@ def main() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         t0 = time.perf_counter()
-        res = mi.design(target, verify=False, effort=mi.Effort(seed=0))
+        quick = dict(refine=False, hedge=0, fallback=0) if args.zero_shot else {}
+        res = mi.design(target, verify=False, effort=mi.Effort(seed=0, **quick))
     print(
         f"design: error {100 * res.error:.2f} % ({time.perf_counter() - t0:.0f} s), "
         f"zero-shot from {res.zero_shot_from}",

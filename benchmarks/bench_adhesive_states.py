@@ -26,6 +26,10 @@ from metainterface.verify.adhesive import APPROACHES_PER_LOAD, approaches, clear
 W = 0.05 / (2.4e6 * 0.5e-3)
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--grid 48 --loads 4 --seeds 0 2"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--grid", type=int, default=96)

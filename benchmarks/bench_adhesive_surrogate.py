@@ -177,6 +177,13 @@ def evaluate(args) -> None:
     (Path(args.out) / "evaluation.json").write_text(json.dumps(rows, indent=1))
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = (
+    "--out {tmp} --samples 1000 --budget 2 --max-epochs 1 --eval-cells 20 --variants input"
+    " --physics-steps 32 --batch-size 128"
+)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True)

@@ -37,6 +37,10 @@ def timed(fn, reps: int):
     return (time.perf_counter() - t) / reps, out
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "64 1"
+
+
 def main() -> None:
     s = CellSettings()
     b = int(sys.argv[1]) if len(sys.argv) > 1 else 512

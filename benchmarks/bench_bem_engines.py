@@ -68,6 +68,10 @@ def profile(grid: int) -> str:
     return p.key_averages().table(sort_by="self_cpu_time_total", row_limit=12)
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--quick"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--grids", type=int, nargs="+", default=[384, 768])

@@ -52,6 +52,10 @@ def coverage(fit, clean: np.ndarray, seeds: int, label: str) -> None:
     )
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--seeds 1 --sphere-seeds 3"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=40, help="made-design tests")

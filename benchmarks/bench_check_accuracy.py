@@ -141,6 +141,10 @@ def convergence(args: argparse.Namespace) -> str:
     return "\n".join(lines)
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--quick --count 1"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--count", type=int, default=4, help="targets (4)")

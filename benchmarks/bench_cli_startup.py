@@ -32,6 +32,10 @@ CASES = {
 }
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--repeat 1"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=7)
@@ -47,6 +51,8 @@ def main() -> None:
             times.append(time.perf_counter() - t0)
         rows.append((label, statistics.median(times), min(times)))
     lines = [
+        f"`python benchmarks/bench_cli_startup.py {' '.join(sys.argv[1:])}`",
+        "",
         f"Fresh-process wall time, median and best of {args.repeat} "
         f"(load average before: {load:.1f}, {os.cpu_count()} cores)",
         "",

@@ -19,6 +19,10 @@ from metainterface.validation.heightmap import height_map
 RADII = np.array([10.0, 14.0, 18.0, 22.0, 26.0, 30.0])  # grid steps
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--grid 64"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--grid", type=int, default=256)

@@ -28,6 +28,10 @@ def cpu() -> float:
     return t.user + t.system + t.children_user + t.children_system
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--targets 1"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--targets", type=int, default=5)

@@ -72,11 +72,18 @@ def compare(targets: list[Target], seeds: int, rs: RefineSettings) -> None:
         )
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--skip-cli --batch 1 --seeds 1 --builtins saturating"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--skip-cli", action="store_true")
     ap.add_argument("--batch", type=int, default=100)
     ap.add_argument("--seeds", type=int, default=4, help="seeds of the quality comparison")
+    ap.add_argument(
+        "--builtins", nargs="+", default=["saturating", "bilinear", "linear"], metavar="NAME"
+    )
     ap.add_argument(
         "--polish",
         choices=POLISH_METHODS,
@@ -86,7 +93,7 @@ def main() -> None:
     args = ap.parse_args()
     tune_allocator()  # as the CLI does
     rs = RefineSettings(polish_method=args.polish)
-    targets = [builtin_target(n) for n in ("saturating", "bilinear", "linear")]
+    targets = [builtin_target(n) for n in args.builtins]
     design(targets[:1], "surrogate")  # warm-up (imports, model load)
     print(f"torch {torch.__version__}, {torch.get_num_threads()} threads, polish {args.polish}")
     print(f"{'target':<12}{'method':<20}{'zero-shot':>10}{'refined':>9}{'s/target':>10}")

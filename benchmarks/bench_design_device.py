@@ -26,6 +26,9 @@ from metainterface.surrogate.config import TrainConfig
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_design import realisable_targets
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--ks 1"
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)

@@ -61,10 +61,15 @@ def profile(kind: str, rows: int) -> None:
     pstats.Stats(pr).sort_stats("cumtime").print_stats(rows)
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--repeats 1 --batch 1 --builtins saturating"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--batch", type=int, default=100)
+    ap.add_argument("--builtins", nargs="+", metavar="NAME", help="default: all built-ins")
     ap.add_argument("--profile", choices=tuple(KINDS), default=None)
     ap.add_argument("--rows", type=int, default=30, help="profile rows printed")
     args = ap.parse_args()
@@ -78,7 +83,7 @@ def main() -> None:
         f"{'target':<12}{'paper s':>16}{'default s':>16}{'ratio':>7}{'paper err':>11}"
         f"{'default err':>13}"
     )
-    for name in mi.Target.builtins():
+    for name in args.builtins or mi.Target.builtins():
         t = mi.Target.builtin(name)
         tp, cp, ep = timed(t, "paper", args.repeats)
         td, cd, ed = timed(t, "default", args.repeats)

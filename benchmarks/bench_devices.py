@@ -12,7 +12,8 @@ and the table says so. K above --max-k is not run: its figure is the rate of the
 run, marked as extrapolated. A device that torch does not see gets "unmeasured" and the
 reason. Each timed step is run once after a warm-up (the surrogate loaded, caches built).
 
-Run: python benchmarks/bench_devices.py [--quick] [--max-k 1000] [--out results/devices.md]
+Run: python benchmarks/bench_devices.py [--quick | --smoke] [--max-k 1000]
+     [--out results/devices.md]
 """
 
 from __future__ import annotations
@@ -90,8 +91,9 @@ def measure(device: str, args: argparse.Namespace, work: Path) -> dict[str, str]
         cells["500-epoch training"] = f"{500 * epoch:.0f} s (extrapolated: 500 x epoch)"
     print(f"{device}: epoch {epoch:.2f} s", flush=True)
 
-    mi.design("saturating", device=device)  # warm-up: the surrogate, the envelope cache
-    t, one = timed(mi.design, "saturating", device=device)
+    check = {"verify": False} if args.smoke else {}
+    mi.design("saturating", device=device, **check)  # warm-up: the surrogate, the envelope cache
+    t, one = timed(mi.design, "saturating", device=device, **check)
     cells["one design"] = f"{t:.2f} s"
     print(f"{device}: one design {t:.2f} s", flush=True)
 
@@ -102,15 +104,16 @@ def measure(device: str, args: argparse.Namespace, work: Path) -> dict[str, str]
             cells[row] = f"{rate:.2f} (extrapolated: rate at K = {args.max_k})"
             continue
         targets = realisable_targets(k, seed=11)
-        t, _ = timed(mi.design, targets, device=device)
+        t, _ = timed(mi.design, targets, device=device, **check)
         rate = k / t
         cells[row] = f"{rate:.2f} ({t:.1f} s)"
         print(f"{device}: K = {k}: {t:.1f} s, {rate:.2f} designs/s", flush=True)
 
     mi.tolerance(one, sigma_h=0.002, sigma_gamma=0.05, samples=64, device=device)
-    t, _ = timed(mi.tolerance, one, sigma_h=0.002, sigma_gamma=0.05, samples=4096, device=device)
-    cells["tolerance, 4096 samples"] = f"{t:.2f} s"
-    print(f"{device}: tolerance 4096: {t:.2f} s", flush=True)
+    n = 256 if args.smoke else 4096
+    t, _ = timed(mi.tolerance, one, sigma_h=0.002, sigma_gamma=0.05, samples=n, device=device)
+    cells["tolerance, 4096 samples"] = f"{t:.2f} s" + ("" if n == 4096 else f" ({n} samples)")
+    print(f"{device}: tolerance {n}: {t:.2f} s", flush=True)
     return cells
 
 
@@ -128,9 +131,19 @@ def machine(device: str) -> str:
     return f"{name}, {torch.get_num_threads()} torch thread(s)"
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--smoke"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="5k samples, 2 epochs, K <= 10")
+    ap.add_argument(
+        "--smoke",
+        action="store_true",
+        help="2k samples, 1 epoch, K = 1, no BEM check, 256 tolerance samples: a check that "
+        "the script runs (benchmarks/run.py's quick mode), its figures mean nothing",
+    )
     ap.add_argument("--samples", type=int, default=100_000, help="dataset size (100000)")
     ap.add_argument("--epochs", type=int, default=3, help="epochs measured (3)")
     ap.add_argument("--full-training", action="store_true", help="run all 500 epochs")
@@ -140,6 +153,8 @@ def main() -> None:
     args = ap.parse_args()
     if args.quick:
         args.samples, args.epochs, args.max_k = 5000, 2, 10
+    if args.smoke:
+        args.samples, args.epochs, args.max_k = 2000, 1, 1
     tune_allocator()
     columns: dict[str, dict[str, str]] = {}
     where: dict[str, str] = {}

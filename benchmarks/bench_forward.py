@@ -14,6 +14,9 @@ import torch
 from metainterface.physics import CellSettings, curves_numpy
 from metainterface.runtime import tune_allocator
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--designs 1000 --repeat 1"
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)

@@ -160,6 +160,10 @@ def figure(targets: list[mi.Target], fams: list[str], alone: str, path: str) -> 
     fig.savefig(path, dpi=110)
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--laws 4 --held-out 2 --cells 2"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--laws", type=int, default=50, help="friction laws (50)")

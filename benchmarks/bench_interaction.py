@@ -97,7 +97,7 @@ def alpha_at_curvature(g, h, settings, p):
 
 
 def accuracy(args, settings) -> list[str]:
-    cache_file = RESULTS / f"interaction_bem_{args.grid}.json"
+    cache_file = Path(args.cache) / f"interaction_bem_{args.grid}.json"
     cache = json.loads(cache_file.read_text()) if cache_file.exists() else {}
     rows = []
     header = (
@@ -116,7 +116,7 @@ def accuracy(args, settings) -> list[str]:
         if args.only and not any(name.startswith(o) for o in args.only):
             continue
         e = bem(name, g, h, settings, args.grid, args.jobs, cache)
-        RESULTS.mkdir(parents=True, exist_ok=True)
+        cache_file.parent.mkdir(parents=True, exist_ok=True)
         cache_file.write_text(json.dumps(cache, indent=1) + "\n")
         gt = torch.tensor(g, dtype=torch.float64)[None]
         ht = torch.tensor(h, dtype=torch.float64)[None]
@@ -300,6 +300,10 @@ def timing(settings: CellSettings, threads: int) -> list[str]:
     return lines
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--grid 48 --only uniform --cache {tmp}"
+
+
 def main() -> None:
     tune_allocator()  # as the CLI, `design` and `train` run
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
@@ -307,6 +311,7 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=1, help="BEM processes per cell")
     ap.add_argument("--only", nargs="*", help="cell name prefixes, e.g. 'uniform' 'random 03'")
     ap.add_argument("--timing-only", action="store_true")
+    ap.add_argument("--cache", default=str(RESULTS), help="folder of the BEM cache (results/)")
     ap.add_argument(
         "--convergence",
         action="store_true",

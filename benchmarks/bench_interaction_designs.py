@@ -75,14 +75,20 @@ def run_case(target_name: str, model: str, grid: int, jobs: int) -> dict:
     }
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--grid 48 --jobs 1 --targets saturating --cache {tmp}"
+
+
 def main() -> None:
     tune_allocator()
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--grid", type=int, default=768, help="BEM grid M (multiple of 3)")
     ap.add_argument("--jobs", type=int, default=2, help="BEM processes per design")
+    ap.add_argument("--targets", nargs="+", default=list(TARGETS), choices=TARGETS)
+    ap.add_argument("--cache", default=str(RESULTS), help="folder of the BEM cache (results/)")
     ap.add_argument("--out", help="also write the table as Markdown to this file")
     args = ap.parse_args()
-    cache_path = RESULTS / f"interaction_designs_{args.grid}.json"
+    cache_path = Path(args.cache) / f"interaction_designs_{args.grid}.json"
     cache = json.loads(cache_path.read_text()) if cache_path.exists() else {}
     lines = [
         "| target | designed with | design error | model error at the loads | "
@@ -90,7 +96,7 @@ def main() -> None:
         "|---|---|---|---|---|---|---|",
     ]
     print(lines[0], flush=True)
-    for name in TARGETS:
+    for name in args.targets:
         for physics in PHYSICS:
             key = f"{name}|{physics}"
             if "alpha_bem_pixels" not in cache.get(key, {}):  # older: the count only

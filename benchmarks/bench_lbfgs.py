@@ -97,6 +97,10 @@ def load(path: str) -> ModuleType:
     return mod
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--iterations 10 --repeat 1"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--old", help="another lbfgs.py to time against this one")

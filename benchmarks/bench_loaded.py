@@ -155,6 +155,10 @@ def profile(case: str, tmp: Path, law: Path, design: Path, rows: int = 25) -> st
     return "\n".join(keep[-(rows + 1) :])
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--busy 0 --repeat 1 --cases design help --settings best"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--busy", type=int, default=2, help="CPU-bound processes beside (default 2)")

@@ -40,6 +40,10 @@ def timed(module: Any, name: str, label: str, marks: list[tuple[str, float]]) ->
     setattr(module, name, run)
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "design --target saturating --no-verify --out {tmp}"
+
+
 def main() -> None:
     start, wall = cpu(), time.perf_counter()
     marks: list[tuple[str, float]] = []

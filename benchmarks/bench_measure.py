@@ -38,6 +38,10 @@ def made_surface(u, v, design, gamma, h):
     return -(h[k] + r ** gamma[k] / (2 * s.radius ** (gamma[k] - 1)))
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--points 64"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--points", type=int, default=768)

@@ -50,6 +50,16 @@ def overhead(executor: Executor, n: int) -> float:
     return (time.perf_counter() - t0) / n
 
 
+def _warm() -> None:
+    """Import the package's task code in a worker (returning None: a module object does not
+    serialise back to the client)."""
+    import metainterface.validation.executors  # noqa: F401
+
+
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--designs 2 --grid 48 --loads 2 --tasks 10"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--designs", type=int, default=8)
@@ -86,7 +96,7 @@ def main() -> None:
         ):
             ex = client.get_executor(pure=False)
             # workers import the package once before the clock starts
-            client.run(__import__, "metainterface.validation.executors")
+            client.run(_warm)
             warm = sweep(paths, root / "dask2", g, k, executor=ex)
             rows.append(
                 (f"Dask, {args.workers} running workers (executor=)", warm, os.getloadavg()[0])

@@ -1,6 +1,7 @@
 """Benchmark: seconds per training epoch of the surrogate over 80,000 training samples.
 
-    python benchmarks/bench_train.py [--dataset FILE] [--epochs 4] [--batch-size 512]
+    python benchmarks/bench_train.py [--dataset FILE | --samples 100000] [--epochs 4]
+        [--batch-size 512]
 
 Target (issue 4) on the 2-core dev machine: <= 3 s an epoch, validation and the atomic
 checkpoint included (what metrics.csv records), for the recipe of the shipped model. Without
@@ -34,9 +35,14 @@ def _minor_faults() -> int:
     return resource.getrusage(resource.RUSAGE_SELF).ru_minflt
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--samples 2000 --epochs 2"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--dataset", help="dataset .npz (default: generate 100,000 samples)")
+    parser.add_argument("--samples", type=int, default=100_000, help="without --dataset")
     parser.add_argument("--epochs", type=int, default=4)
     parser.add_argument("--batch-size", type=int, default=512)
     args = parser.parse_args()
@@ -44,7 +50,7 @@ def main() -> None:
         path = args.dataset
         if path is None:
             path = Path(tmp) / "data.npz"
-            generate_dataset(100_000, 0, CellSettings(), path, progress=False)
+            generate_dataset(args.samples, 0, CellSettings(), path, progress=False)
         ds = load_dataset(path)
         train_split, val_split = split_of(ds, "train"), split_of(ds, "val")
         config = TrainConfig(

@@ -56,6 +56,10 @@ def scaling(jobs: int) -> None:
         )
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--only small"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--jobs", type=int, default=min(2, available_cpus()))

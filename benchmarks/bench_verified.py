@@ -175,6 +175,10 @@ def summary(rows: list[dict], grids: list[int]) -> list[str]:
     return out
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--quick --grids 96 --loads 4 --n-random 1 --no-analytic --only saturating --iterations 1"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--grids", type=int, nargs="+", help="(384 768)")

@@ -8,13 +8,17 @@
    absolute log10 errors of P*_max and alpha_max (magnitudes).
 
 Run: python benchmarks/surrogate_diagnostics.py --dataset ds100k.npz [--model FILE]
+     python benchmarks/surrogate_diagnostics.py --samples 100000   (a fresh dataset, seed 0)
 """
 
 import argparse
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import torch
 
+from metainterface import generate_dataset
 from metainterface.data import load_dataset
 from metainterface.physics.curves import curve
 from metainterface.physics.metrics import relative_l2
@@ -69,14 +73,25 @@ def shape_and_magnitude(ds, model_path) -> None:
         )
 
 
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--samples 2000"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--dataset", required=True)
+    source = ap.add_mutually_exclusive_group(required=True)
+    source.add_argument("--dataset")
+    source.add_argument("--samples", type=int, help="generate a dataset of this size (seed 0)")
     ap.add_argument("--model", default=None, help="default: the shipped surrogate")
     args = ap.parse_args()
-    ds = load_dataset(args.dataset)
-    reach(ds.subset("test"))
-    shape_and_magnitude(ds, args.model or default_model_path())
+    with tempfile.TemporaryDirectory() as tmp:
+        path = args.dataset
+        if path is None:
+            path = Path(tmp) / "data.npz"
+            generate_dataset(args.samples, path, seed=0, progress=False)
+        ds = load_dataset(path)
+        reach(ds.subset("test"))
+        shape_and_magnitude(ds, args.model or default_model_path())
 
 
 if __name__ == "__main__":

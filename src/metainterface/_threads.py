@@ -162,16 +162,3 @@ def uses_threads(work: Work = "light") -> Callable[[F], F]:
         return run  # type: ignore[return-value]
 
     return wrap
-
-
-def threads_now() -> dict[str, Any]:
-    """What the thread policy is, for reports: the wait policy, the user's choice, torch's
-    count (without importing torch)."""
-    torch = sys.modules.get("torch")
-    return {
-        "wait_policy": os.environ.get(WAIT_ENV, "") or "unset",
-        "chosen": _state.chosen,
-        "env": {name: os.environ[name] for name in USER_ENV if os.environ.get(name)},
-        "torch_threads": None if torch is None else torch.get_num_threads(),
-        "torch_loaded_first": _state.torch_first,
-    }

@@ -286,40 +286,10 @@ def generate_dataset(
     counts = allocate(samples, [c.fraction for c in CATEGORIES])
     labels = _split_labels(counts, seed)
     per_split = np.bincount(labels, minlength=len(SPLITS))
-    meta = provenance(
-        format=FORMAT,
-        samples=samples,
-        seed=seed,
-        cell=settings.to_dict(),
-        block=block,
-        curves={"bracket": "exact", "dtype": "float32", "n_steps": settings.n_steps},
-        categories={
-            c.name: {"fraction": c.fraction, "count": int(n), "params": asdict(p)}
-            for c, n, p in zip(CATEGORIES, counts, cat_params, strict=True)
-        },
-        splits={
-            "fractions": dict(zip(SPLITS, SPLIT_FRACTIONS, strict=True)),
-            "counts": {s: int(n) for s, n in zip(SPLITS, per_split, strict=True)},
-            "stratified_by": "category",
-        },
-    )
-    meta_text = json.dumps(meta, sort_keys=True)
-    n, steps = settings.n_asperities, settings.n_steps
-    cat_dtype = f"<U{max(len(s) for s in CATEGORY_NAMES)}"
-    split_dtype = f"<U{max(len(s) for s in SPLITS)}"
-    specs = {
-        "gamma": ((samples, n), np.float64),
-        "h": ((samples, n), np.float64),
-        "category": ((samples,), cat_dtype),
-        "split": ((samples,), split_dtype),
-        "p_star_max": ((samples,), np.float32),
-        "alpha_max": ((samples,), np.float32),
-        "alpha_hat": ((samples, steps), np.float32),
-        "stiffness_hat": ((samples, steps), np.float32),
-        "meta": ((), f"<U{len(meta_text)}"),
-    }
-    cat_names = np.array(CATEGORY_NAMES, dtype=cat_dtype)
-    split_names = np.array(SPLITS, dtype=split_dtype)
+    meta_text = _meta_text(samples, seed, settings, block, counts, per_split, cat_params)
+    specs = _array_specs(samples, settings, meta_text)
+    cat_names = np.array(CATEGORY_NAMES, dtype=specs["category"][1])
+    split_names = np.array(SPLITS, dtype=specs["split"][1])
     kept: dict[int, list[dict[str, np.ndarray]]] = {c: [] for c in range(len(CATEGORIES))}
 
     from tqdm import tqdm
@@ -395,6 +365,55 @@ def generate_dataset(
         seconds=time.perf_counter() - started,
         examples=example_arrays,
     )
+
+
+def _meta_text(
+    samples: int,
+    seed: int,
+    settings: CellSettings,
+    block: int,
+    counts: np.ndarray,
+    per_split: np.ndarray,
+    cat_params: list[Any],
+) -> str:
+    """The file's "meta" entry (JSON): format, seed, cell, block, categories, splits and the
+    provenance of the run."""
+    meta = provenance(
+        format=FORMAT,
+        samples=samples,
+        seed=seed,
+        cell=settings.to_dict(),
+        block=block,
+        curves={"bracket": "exact", "dtype": "float32", "n_steps": settings.n_steps},
+        categories={
+            c.name: {"fraction": c.fraction, "count": int(n), "params": asdict(p)}
+            for c, n, p in zip(CATEGORIES, counts, cat_params, strict=True)
+        },
+        splits={
+            "fractions": dict(zip(SPLITS, SPLIT_FRACTIONS, strict=True)),
+            "counts": {s: int(n) for s, n in zip(SPLITS, per_split, strict=True)},
+            "stratified_by": "category",
+        },
+    )
+    return json.dumps(meta, sort_keys=True)
+
+
+def _array_specs(
+    samples: int, settings: CellSettings, meta_text: str
+) -> dict[str, tuple[tuple[int, ...], Any]]:
+    """name -> (shape, dtype) of every array the .npz holds, for the streaming writer."""
+    n, steps = settings.n_asperities, settings.n_steps
+    return {
+        "gamma": ((samples, n), np.float64),
+        "h": ((samples, n), np.float64),
+        "category": ((samples,), f"<U{max(len(s) for s in CATEGORY_NAMES)}"),
+        "split": ((samples,), f"<U{max(len(s) for s in SPLITS)}"),
+        "p_star_max": ((samples,), np.float32),
+        "alpha_max": ((samples,), np.float32),
+        "alpha_hat": ((samples, steps), np.float32),
+        "stiffness_hat": ((samples, steps), np.float32),
+        "meta": ((), f"<U{len(meta_text)}"),
+    }
 
 
 def check_curves(curves: Mapping[str, np.ndarray], settings: CellSettings, first_row: int) -> None:

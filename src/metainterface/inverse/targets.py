@@ -328,12 +328,6 @@ def target_from_csv(path: str | os.PathLike[str], name: str | None = None) -> Ta
     )
 
 
-def target_grid(target: Target, n: int = 128) -> tuple[np.ndarray, np.ndarray]:
-    """The target on n uniform pressures over [0, P*_max]: (p (n,), alpha (n,))."""
-    grid = np.linspace(0.0, target.p_star_max, n)
-    return grid, np.interp(grid, target.p_star, target.alpha, left=0.0)
-
-
 def target_features(
     target: Target, n_steps: int = 128, s_hat_max: float = S_HAT_MAX
 ) -> torch.Tensor:

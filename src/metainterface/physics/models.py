@@ -1,4 +1,5 @@
-"""Forward models as objects, and the one registry every command reads.
+"""Forward models as objects: the interface and the two shipped models (the registry that
+names them is ``physics.registry``).
 
 A forward model maps (B, N) designs to their response along a Delta sweep. Two ship:
 

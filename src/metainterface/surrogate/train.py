@@ -188,30 +188,9 @@ def train(
     history: list[dict[str, float]] = []
     start, best, best_epoch, bad = 0, math.inf, -1, 0
     if resume:
-        if not ckpt_path.is_file():
-            raise MetainterfaceError(f"--resume: no checkpoint in {out}")
-        state = load_torch(ckpt_path, "checkpoint")
-        if state["config"] != asdict(config):
-            changed = sorted(k for k, v in asdict(config).items() if state["config"].get(k, v) != v)
-            was = ", ".join(f"{k} {state['config'].get(k)!r}" for k in changed)
-            raise MetainterfaceError(
-                f"--resume: {ckpt_path} was made with other settings ({was}); give the "
-                "same options or another --out"
-            )
-        _same_dataset(ckpt_path, state.get("dataset"), dataset_info)
-        model.load_state_dict(state["model"])
-        opt.load_state_dict(state["optimizer"])
-        sched.load_state_dict(state["scheduler"])
-        torch.set_rng_state(state["rng"])
-        if dev.type == "cuda" and "cuda_rng" in state:  # dropout draws there on CUDA
-            torch.cuda.set_rng_state(state["cuda_rng"], dev)
-        start, best, best_epoch, bad = (
-            state["epoch"],
-            state["best"],
-            state["best_epoch"],
-            state["bad"],
+        start, best, best_epoch, bad, history = _resume(
+            ckpt_path, config, dataset_info, model, opt, sched, dev
         )
-        history = state["history"]
     elif ckpt_path.exists():
         raise MetainterfaceError(f"{out} already holds a run; use --resume or another --out")
     run_info = {
@@ -224,7 +203,6 @@ def train(
     }
     write_text(out / "config.json", strict_json.dumps(run_info, indent=2, default=str) + "\n")
     schedules = config.schedules
-    n = len(train_split)
     t_run = time.perf_counter()
     stopped = False
     bar = tqdm(
@@ -238,38 +216,7 @@ def train(
     for epoch in bar:
         t0 = time.perf_counter()
         kappa, lam = schedules.kappa(epoch), schedules.lam(epoch)
-        model.train()
-        # drawn on the CPU whatever the device: the same seed, the same batches everywhere
-        order = torch.randperm(
-            n, generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch)
-        ).to(dev)
-        # summed on the device and read once an epoch (a float() per batch would wait for
-        # each step to finish); float64, so the sum equals the per-batch Python sum on CPU
-        epoch_loss = torch.zeros((), dtype=torch.float64, device=dev)
-        batches = 0
-        for lo in range(0, n - config.batch_size + 1, config.batch_size):
-            feats, targets, g_t, h_t = train_split.rows(order[lo : lo + config.batch_size])
-            gamma, h = model.design(feats, settings)
-            loss = batch_loss(
-                gamma,
-                h,
-                targets,
-                settings,
-                config.weights,
-                config.reads,
-                kappa,
-                config.physics_steps,
-                adhesion=train_split.adhesion_rows(order[lo : lo + config.batch_size]),
-                window=schedules.window(epoch),
-            )
-            if lam > 0:
-                loss = loss + lam * param_loss(gamma, h, g_t, h_t, settings)
-            opt.zero_grad(set_to_none=True)
-            loss.backward()
-            opt.step()
-            epoch_loss += loss.detach()
-            batches += 1
-        run_loss = float(epoch_loss)
+        run_loss, batches = _train_epoch(model, opt, train_split, settings, config, epoch, dev)
         lr = opt.param_groups[0]["lr"]
         sched.step()
         val = evaluate_loss(
@@ -331,6 +278,86 @@ def train(
             break
     bar.close()
     return TrainResult(out, len(history), best_epoch, best, stopped, time.perf_counter() - t_run)
+
+
+def _resume(
+    ckpt_path: Path,
+    config: TrainConfig,
+    dataset_info: dict[str, Any] | None,
+    model: InverseMLP,
+    opt: torch.optim.Optimizer,
+    sched: Any,
+    dev: torch.device,
+) -> tuple[int, float, int, int, list[dict[str, float]]]:
+    """Load a run's checkpoint into model, optimiser, scheduler and the RNGs: (epochs done,
+    best validation loss, its epoch, epochs since, history). A checkpoint made with other
+    settings or on another dataset is refused, naming what differs."""
+    if not ckpt_path.is_file():
+        raise MetainterfaceError(f"--resume: no checkpoint in {ckpt_path.parent}")
+    state = load_torch(ckpt_path, "checkpoint")
+    if state["config"] != asdict(config):
+        changed = sorted(k for k, v in asdict(config).items() if state["config"].get(k, v) != v)
+        was = ", ".join(f"{k} {state['config'].get(k)!r}" for k in changed)
+        raise MetainterfaceError(
+            f"--resume: {ckpt_path} was made with other settings ({was}); give the "
+            "same options or another --out"
+        )
+    _same_dataset(ckpt_path, state.get("dataset"), dataset_info)
+    model.load_state_dict(state["model"])
+    opt.load_state_dict(state["optimizer"])
+    sched.load_state_dict(state["scheduler"])
+    torch.set_rng_state(state["rng"])
+    if dev.type == "cuda" and "cuda_rng" in state:  # dropout draws there on CUDA
+        torch.cuda.set_rng_state(state["cuda_rng"], dev)
+    return state["epoch"], state["best"], state["best_epoch"], state["bad"], state["history"]
+
+
+def _train_epoch(
+    model: InverseMLP,
+    opt: torch.optim.Optimizer,
+    train_split: Split,
+    settings: CellSettings,
+    config: TrainConfig,
+    epoch: int,
+    dev: torch.device,
+) -> tuple[float, int]:
+    """One epoch of AdamW steps over the shuffled training split, the epoch's kappa_s,
+    lambda and snap window: (summed batch loss, batches)."""
+    schedules = config.schedules
+    kappa, lam = schedules.kappa(epoch), schedules.lam(epoch)
+    n = len(train_split)
+    model.train()
+    # drawn on the CPU whatever the device: the same seed, the same batches everywhere
+    order = torch.randperm(
+        n, generator=torch.Generator().manual_seed(config.seed * 100_003 + epoch)
+    ).to(dev)
+    # summed on the device and read once an epoch (a float() per batch would wait for
+    # each step to finish); float64, so the sum equals the per-batch Python sum on CPU
+    epoch_loss = torch.zeros((), dtype=torch.float64, device=dev)
+    batches = 0
+    for lo in range(0, n - config.batch_size + 1, config.batch_size):
+        feats, targets, g_t, h_t = train_split.rows(order[lo : lo + config.batch_size])
+        gamma, h = model.design(feats, settings)
+        loss = batch_loss(
+            gamma,
+            h,
+            targets,
+            settings,
+            config.weights,
+            config.reads,
+            kappa,
+            config.physics_steps,
+            adhesion=train_split.adhesion_rows(order[lo : lo + config.batch_size]),
+            window=schedules.window(epoch),
+        )
+        if lam > 0:
+            loss = loss + lam * param_loss(gamma, h, g_t, h_t, settings)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        opt.step()
+        epoch_loss += loss.detach()
+        batches += 1
+    return float(epoch_loss), batches
 
 
 def _file_hash(path: str) -> str | None:

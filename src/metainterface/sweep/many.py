@@ -1,17 +1,13 @@
-"""A sweep over many designs (:func:`validate_many`): each design's folder written whole
-(built under a hidden name, then renamed) and ``summary.csv``, one row per finished design,
-after each design; a finished design with the same request is kept, not solved again."""
+"""A BEM sweep over many designs (:func:`validate_many`): the designs listed and planned,
+finished ones with the same request kept, the rest solved on local processes, a Dask
+cluster or an executor (their folders and summary.csv written by ``sweep.collect``)."""
 
 from __future__ import annotations
 
-import collections
 import contextlib
-import csv
-import io
 import json
 import os
 import shutil
-import uuid
 from collections.abc import Sequence
 from concurrent.futures import Executor
 from pathlib import Path
@@ -20,12 +16,6 @@ from typing import Any
 import numpy as np
 
 from metainterface import _checks
-from metainterface._files import (
-    csv_header,
-    provenance,
-    strict_json,
-    write_text,
-)
 from metainterface._names import DEFAULT_ENGINE
 from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
@@ -33,12 +23,12 @@ from metainterface.io.fields import FIELDS_FILE, require_xarray
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
 from metainterface.physics.registry import get_model
-from metainterface.sweep.folders import request_hash, warn_adhesive, write_result
+from metainterface.sweep.collect import Collector
+from metainterface.sweep.folders import request_hash, warn_adhesive
 from metainterface.validation.batched import solve_batched
 from metainterface.validation.bem import (
     MAX_ITER,
     TOLERANCE,
-    LoadPath,
     available_cpus,
 )
 from metainterface.validation.cluster import check_scheduler, dask_executor
@@ -49,16 +39,6 @@ from metainterface.validation.validate import (
     ValidationPlan,
     check_jobs,
     plan_validation,
-)
-
-#: Columns of summary.csv, one row per design.
-SUMMARY_COLUMNS = (
-    "name",
-    "status",
-    "max_rel_err_upper_half",
-    "target_error_bem",
-    "target_error_model",
-    "error",
 )
 
 
@@ -131,21 +111,6 @@ def _stored(folder: Path, request: dict[str, Any], fields: bool, figure: bool) -
     return record.get("summary")
 
 
-def _swap_in(staging: Path, final: Path) -> None:
-    """Put a finished folder in place of ``final`` (two renames, no half-written folder)."""
-    if final.exists():
-        old = final.with_name(f".{final.name}.old-{uuid.uuid4().hex[:8]}")
-        os.replace(final, old)
-        os.replace(staging, final)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.replace(staging, final)
-
-
-def _staging(out: Path, name: str) -> Path:
-    return out / f".{name}.partial-{uuid.uuid4().hex[:8]}"
-
-
 def _clear_leftovers(out: Path) -> None:
     """Remove what a sweep killed while writing leaves: hidden design folders, and the
     temporary files of summary.csv / summary.json (``atomic_open``'s ``.NAME.*.tmp``)."""
@@ -155,40 +120,6 @@ def _clear_leftovers(out: Path) -> None:
         for name in ("summary.csv", "summary.json"):
             for tmp in out.glob(f".{name}.*.tmp"):
                 tmp.unlink(missing_ok=True)
-
-
-def summary_row(name: str, summary: dict[str, Any]) -> dict[str, Any]:
-    """One row of summary.csv: name, status (ok / failed), the largest relative error over
-    the upper half of the loads, the target errors (BEM, model; blank without a target),
-    the error message of a failed design."""
-    if "error" in summary:
-        return {"name": name, "status": "failed", "error": summary["error"]}
-    return {
-        "name": name,
-        "status": "ok",
-        "max_rel_err_upper_half": summary.get("max_rel_err_upper_half"),
-        "target_error_bem": summary.get("target_error_bem"),
-        "target_error_model": summary.get("target_error_model"),
-    }
-
-
-def _cell(value: Any) -> Any:
-    if value is None:
-        return ""
-    return repr(float(value)) if isinstance(value, float) else value  # repr: exact floats
-
-
-def _write_summary(out: Path, rows: list[dict[str, Any]], **settings: Any) -> None:
-    buf = io.StringIO()
-    buf.write(csv_header(**settings))
-    writer = csv.DictWriter(buf, SUMMARY_COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        cells = {k: _cell(v) for k, v in row.items()}
-        # '#' starts a comment for pandas.read_csv(comment="#"): keep messages readable there
-        cells["error"] = str(cells.get("error", "")).replace("#", "no.").replace("\n", " ")
-        writer.writerow(cells)
-    write_text(out / "summary.csv", buf.getvalue())
 
 
 @uses_threads()
@@ -269,56 +200,16 @@ def validate_many(
     the next run.
     """
     solver = check_engine(engine, device)
-    jobs = available_cpus() if jobs is None else check_jobs(jobs)
-    if executor is None and scheduler is None and solver.name == "torch" and jobs > 1:
-        from metainterface._device import resolve_device
-
-        if resolve_device(device).type == "cuda":
-            jobs = 1  # one process drives the GPU (a forked child cannot use CUDA)
-    chunks = _checks.whole("chunks", chunks, low=1, high=10_000)
-    retries = _checks.whole("retries", retries, low=0, high=100)
-    if fields:
-        require_xarray()
-    if executor is not None and scheduler is not None:
-        raise MetainterfaceError("give executor or scheduler, not both")
-    if scheduler is not None:
-        check_scheduler(scheduler)
-    here = executor is None and scheduler is None and chunks == 1 and solver.name == "torch"
-    if batch is not None:
-        batch = _checks.whole("batch", batch, low=1, high=1024)
-        if batch > 1 and not here:
-            raise MetainterfaceError(
-                "batch > 1 needs engine='torch' solving in this process (no executor or "
-                "scheduler, chunks=1)",
-                argument="batch",
-            )
+    jobs, chunks, retries, batch, here = _check_run(
+        solver.name, jobs, chunks, retries, executor, scheduler, device, fields, batch
+    )
     out = Path(out_dir)
     items = _design_list(designs)
     warn_adhesive(items, get_model(model))
-    summaries: dict[str, dict[str, Any]] = {}
-    todo: list[ValidationPlan] = []
-    for name, design in items:
-        try:
-            prep = plan_validation(
-                design,
-                name=name,
-                grid=grid,
-                loads=loads,
-                model=model,
-                tolerance=tolerance,
-                max_iter=max_iter,
-                engine=engine,
-                device=device,
-            )
-        except MetainterfaceError as exc:
-            raise MetainterfaceError(f"{name}: {exc}") from None
-        done = _stored(out / name, prep.request(), fields, figures)
-        if done is not None:
-            summaries[name] = done
-        else:
-            todo.append(prep)
+    plan = dict(grid=grid, loads=loads, model=model, tolerance=tolerance, max_iter=max_iter)
+    summaries, todo = _plan(items, out, plan, engine, device, fields, figures)
     _clear_leftovers(out)
-    sweep = {
+    settings = {
         "command": "validate_many",
         "grid": grid,
         "loads": loads if isinstance(loads, int) else [float(p) for p in loads],
@@ -327,13 +218,6 @@ def validate_many(
         "max_iter": max_iter,
         "engine": get_engine(engine).name,
     }
-
-    def write_summary() -> None:
-        ordered = {n: summaries[n] for n, _ in items if n in summaries}
-        _write_summary(out, [summary_row(n, s) for n, s in ordered.items()], **sweep)
-        record = {"designs": ordered, "provenance": provenance(**sweep)}
-        write_text(out / "summary.json", strict_json.dumps(record, indent=2) + "\n")
-
     # one design's chunks: (design index in todo, its tasks); flat list for the engine
     tasks, owner = [], []
     # in this process (no executor, one job) torch keeps its threads; workers run on one
@@ -342,46 +226,7 @@ def validate_many(
         for task in prep.tasks(chunks, fields=fields, threads=threads):
             tasks.append(task)
             owner.append(d)
-    parts: dict[int, dict[int, LoadPath]] = {d: {} for d in range(len(todo))}
-    failed: set[int] = set()
-    n_chunks = collections.Counter(owner)
-
-    bar: Any = None
-
-    def on_done(i: int, part: LoadPath) -> None:
-        d = owner[i]
-        if d in failed:
-            return
-        parts[d][i] = part
-        if len(parts[d]) < n_chunks[d]:
-            return
-        prep = todo[d]
-        path = LoadPath.concat([parts[d][j] for j in sorted(parts[d])])
-        parts[d].clear()
-        result = prep.result(path)
-        staging = _staging(out, prep.name)
-        write_result(result, staging, figure=figures, command="validate_many")
-        _swap_in(staging, out / prep.name)
-        summaries[prep.name] = result.summary()
-        write_summary()
-        if bar is not None:
-            bar.update(1)
-
-    def on_error(i: int, exc: BaseException) -> None:
-        d = owner[i]
-        if d in failed:
-            return
-        failed.add(d)
-        parts[d].clear()
-        prep = todo[d]
-        staging = _staging(out, prep.name)
-        write_text(staging / "error.txt", f"{exc}\n")
-        _swap_in(staging, out / prep.name)
-        summaries[prep.name] = {"name": prep.name, "error": str(exc)}
-        write_summary()
-        if bar is not None:
-            bar.update(1)
-
+    sink = Collector(out, items, summaries, todo, owner, settings, figures)
     if batch is None:
         batch = 1
         if here and todo:
@@ -395,18 +240,85 @@ def validate_many(
         if progress and todo:
             from tqdm.auto import tqdm
 
-            bar = stack.enter_context(tqdm(total=len(todo), desc="designs", unit="design"))
+            sink.bar = stack.enter_context(tqdm(total=len(todo), desc="designs", unit="design"))
         if batch > 1:  # one task per design: task i is design i
-            solve_batched(todo, batch, fields=fields, on_done=on_done, on_error=on_error)
+            solve_batched(todo, batch, fields=fields, on_done=sink.on_done, on_error=sink.on_error)
         else:
             stream(
                 solve_task,
                 tasks,
                 executor=executor,
                 jobs=jobs,
-                on_done=on_done,
-                on_error=on_error,
+                on_done=sink.on_done,
+                on_error=sink.on_error,
                 retries=retries,
             )
-    write_summary()
+    sink.write_summary()
     return {n: summaries[n] for n, _ in items}
+
+
+def _check_run(
+    solver: str,
+    jobs: int | None,
+    chunks: int,
+    retries: int,
+    executor: Executor | None,
+    scheduler: str | None,
+    device: str,
+    fields: bool,
+    batch: int | None,
+) -> tuple[int, int, int, int | None, bool]:
+    """validate_many's run settings checked: (jobs, chunks, retries, batch, here), where
+    ``here``: the torch engine solving in this process (no executor or scheduler, one
+    chunk a design), the one case where a batch of designs may be solved together."""
+    jobs = available_cpus() if jobs is None else check_jobs(jobs)
+    if executor is None and scheduler is None and solver == "torch" and jobs > 1:
+        from metainterface._device import resolve_device
+
+        if resolve_device(device).type == "cuda":
+            jobs = 1  # one process drives the GPU (a forked child cannot use CUDA)
+    chunks = _checks.whole("chunks", chunks, low=1, high=10_000)
+    retries = _checks.whole("retries", retries, low=0, high=100)
+    if fields:
+        require_xarray()
+    if executor is not None and scheduler is not None:
+        raise MetainterfaceError("give executor or scheduler, not both")
+    if scheduler is not None:
+        check_scheduler(scheduler)
+    here = executor is None and scheduler is None and chunks == 1 and solver == "torch"
+    if batch is not None:
+        batch = _checks.whole("batch", batch, low=1, high=1024)
+        if batch > 1 and not here:
+            raise MetainterfaceError(
+                "batch > 1 needs engine='torch' solving in this process (no executor or "
+                "scheduler, chunks=1)",
+                argument="batch",
+            )
+    return jobs, chunks, retries, batch, here
+
+
+def _plan(
+    items: list[tuple[str, Design]],
+    out: Path,
+    plan: dict[str, Any],
+    engine: str,
+    device: str,
+    fields: bool,
+    figures: bool,
+) -> tuple[dict[str, dict[str, Any]], list[ValidationPlan]]:
+    """(summaries kept, plans to solve): each design planned with ``plan``'s settings; one
+    whose folder holds a finished result of the same request (and the files asked for) is
+    kept, not solved again. A design that cannot be planned is an error naming it."""
+    summaries: dict[str, dict[str, Any]] = {}
+    todo: list[ValidationPlan] = []
+    for name, design in items:
+        try:
+            prep = plan_validation(design, name=name, engine=engine, device=device, **plan)
+        except MetainterfaceError as exc:
+            raise MetainterfaceError(f"{name}: {exc}") from None
+        done = _stored(out / name, prep.request(), fields, figures)
+        if done is not None:
+            summaries[name] = done
+        else:
+            todo.append(prep)
+    return summaries, todo

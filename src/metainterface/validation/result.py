@@ -14,6 +14,7 @@ from metainterface import _checks
 from metainterface._names import DEFAULT_ENGINE
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
+from metainterface.physics.grid_error import grid_curve_error
 from metainterface.physics.models import ForwardModel, ModelCurve
 from metainterface.physics.registry import models_at
 from metainterface.validation.heightmap import HeightMap
@@ -119,16 +120,26 @@ class ValidationResult:
         alpha (K,), measured at this result's loads, against the design's target; or None
         without a target.
 
-        Measured as ``design`` measures: on the target's uniform grid of ``ERROR_POINTS``
-        pressures, with the model's exact alpha there times alpha / alpha_model interpolated
-        between the loads (so the model's own alpha scores exactly the model's design
-        error, and the BEM's differs only by the measured ratio); coverage is the load
-        path's P*_max (the design's) over the target's largest load.
+        Measured as ``design`` measures, by :func:`~metainterface.physics.grid_error.
+        grid_curve_error`: on the target's uniform grid of ``ERROR_POINTS`` pressures, with
+        the model's exact alpha there times alpha / alpha_model interpolated between the
+        loads (a ratio that is not finite counts as 1; so the model's own alpha scores
+        exactly the model's design error, and the BEM's differs only by the measured ratio);
+        coverage is the design's P*_max over the target's largest load.
         """
         target = design_target(self.design)
         if target is None:
             return None
-        return _grid_error(self.design, self.model, target, self.p_star, alpha / self.alpha_model)
+        gamma, h = self.design.tensors(torch.float64)
+        err, _ = grid_curve_error(
+            gamma.numpy(),
+            h.numpy(),
+            self.design.settings,
+            target,
+            self.model,
+            ratio=(self.p_star, alpha / self.alpha_model),
+        )
+        return float(err[0])
 
     def target_errors(self) -> tuple[float, float] | None:
         """``target_error`` of BEM and model: (BEM, model), or None.
@@ -192,34 +203,6 @@ class ValidationResult:
             "bem_seconds": float(self.seconds.sum()),
             **extra,
         }
-
-
-#: Points of the uniform grid every curve error is measured on (RefineSettings.grid_points).
-ERROR_POINTS = 128
-
-
-def _grid_error(
-    design: Design,
-    model: ForwardModel,
-    target: tuple[np.ndarray, np.ndarray],
-    loads: np.ndarray,
-    ratio: np.ndarray,
-) -> float:
-    """curve_error on the target's ERROR_POINTS grid of the model's exact alpha times
-    ``ratio`` (K,) interpolated in the ``loads`` (K,), held at the ends."""
-    from metainterface.physics.metrics import curve_error
-
-    p_t, a_t = target
-    grid = np.linspace(0.0, float(p_t[-1]), ERROR_POINTS)
-    ref = np.interp(grid, p_t, a_t, left=0.0)
-    gamma, h = design.tensors(torch.float64)
-    with torch.no_grad():
-        alpha, p_max = model.alpha_at(
-            gamma, h, design.settings, torch.as_tensor(grid)[None], exact=True
-        )
-    scale = np.interp(grid, loads, np.nan_to_num(ratio, nan=1.0, posinf=1.0))
-    err = curve_error(alpha.numpy() * scale, ref[None], grid[None], p_max.numpy())
-    return float(err[0])
 
 
 def design_target(design: Design) -> tuple[np.ndarray, np.ndarray] | None:
