@@ -21,7 +21,6 @@ the check runs there whatever ``Verify.engine`` says (a note says so).
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,49 +30,13 @@ from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
-
-#: Approaches of the path per load asked for (``Verify.loads``): some states of the path
-#: are not on the rising-force branch (just after a snap-in the force dips below its running
-#: maximum), so the path takes more samples than the loads it is asked for.
-APPROACHES_PER_LOAD = 2
-#: A BEM state with an asperity in contact is on the rising-force branch only at or above
-#: this factor times the load the model's cell carries just before that asperity touches
-#: (``ForwardModel.touch_loads``): the margin covers the BEM's own touch load lying a few
-#: per cent from the model's (states within it sit at a snap-in, where alpha jumps).
-TOUCH_MARGIN = 1.05
-
-
-def approaches(design: Design, model: ForwardModel, top: float, k: int) -> np.ndarray:
-    """(K,) rising approaches [length]: uniform from 0 to one step past the first approach
-    at which the model's loading curve reaches the load ``top`` (at most Delta_max)."""
-    s = design.settings
-    gamma, h = design.tensors(torch.float64)
-    with torch.no_grad():
-        sweep = model.sweep(gamma, h, s)
-    delta = (sweep.delta[0] if sweep.delta.dim() == 2 else sweep.delta).numpy()
-    reach = np.nonzero(sweep.p_star[0].numpy() >= top * (1 - 1e-9))[0]
-    end = float(delta[reach[0]]) if reach.size else s.delta_max
-    end = min(s.delta_max, end * (1 + 1.0 / k))
-    return end * np.arange(1, k + 1) / k
-
-
-def clear_of_snap_ins(p_star: np.ndarray, touching: np.ndarray, peaks: np.ndarray) -> np.ndarray:
-    """(K,) bool: the BEM states (P* (K,), asperities in contact (K, N)) clear of the model's
-    snap-ins (``peaks`` (N,), the model's ``touch_loads``); with the path's ``on_branch``,
-    the states the check compares.
-
-    A state with asperity i in contact below the load the cell had just before i touched
-    was met by approach only: a rising force jumps over it (the sampled running maximum
-    misses that peak when no approach falls just before the touch). A state within a factor
-    TOUCH_MARGIN of a snap-in reads either side of the jump. Both are left out; a state
-    without i in contact well above i's snap-in load is kept: there the BEM touches later
-    than the model, a disagreement the check must see.
-    """
-    p = p_star[:, None]
-    snaps = peaks[None, :] > 0
-    skipped = touching & (p < TOUCH_MARGIN * peaks[None, :])
-    at_jump = ~touching & (p > peaks[None, :] / TOUCH_MARGIN) & (p < TOUCH_MARGIN * peaks[None, :])
-    return ~((skipped | at_jump) & snaps).any(1)
+from metainterface.validation.adhesive_path import (  # noqa: F401  (re-exported)
+    APPROACHES_PER_LOAD,
+    TOUCH_MARGIN,
+    approaches,
+    clear_of_snap_ins,
+    rising_branch,
+)
 
 
 @dataclass(frozen=True)
@@ -103,26 +66,12 @@ def solve_adhesive(
     ``APPROACHES_PER_LOAD * loads`` approaches; ``engine``: the one asked for (noted when it
     is not torch). Raises MetainterfaceError where no state of the path lies in the
     target's range."""
-    from metainterface._device import resolve_device
-    from metainterface.validation.adhesive_bem import jkr_path
-    from metainterface.validation.heightmap import height_map
-
-    if not model.adhesion:
-        raise MetainterfaceError("the adhesive check needs a model with adhesion > 0")
-    s = design.settings
     top = min(target.p_star_max, model.model_curve(design).p_star_max)
-    deltas = approaches(design, model, top, APPROACHES_PER_LOAD * loads)
-    dev = resolve_device(device)
-    hm = height_map(design, grid)
-    t0 = time.perf_counter()
-    work = model.adhesion * s.e_star * s.radius  # w [E* length] in the cell's units
-    path = jkr_path(hm.heights, hm.cell_side, work, deltas, device=dev, owner=hm.owner)
-    seconds = time.perf_counter() - t0
-    keep = (
-        path.on_branch
-        & clear_of_snap_ins(path.p_star, path.touching, model.touch_loads(design))
-        & (path.p_star <= target.p_star_max * (1 + 1e-9))
+    branch = rising_branch(
+        design, model, grid=grid, samples=APPROACHES_PER_LOAD * loads, top=top, device=device
     )
+    path, deltas, seconds, dev = branch.path, branch.approaches, branch.seconds, branch.device
+    keep = branch.keep & (path.p_star <= target.p_star_max * (1 + 1e-9))
     if not keep.any():
         raise MetainterfaceError(
             "the adhesive BEM reached no load inside the target's range on its rising branch "
@@ -131,7 +80,8 @@ def solve_adhesive(
     p = path.p_star[keep]
     gamma, h = design.tensors(torch.float64)
     with torch.no_grad():
-        mod = model.alpha_at_loads(gamma, h, s, torch.as_tensor(p)[None])[0].numpy()
+        mod = model.alpha_at_loads(gamma, h, design.settings, torch.as_tensor(p)[None])[0]
+    mod = mod.numpy()
     notes = [
         f"adhesive BEM: the JKR limit (Pohrt-Popov criterion) under a rising force, "
         f"w = {model.adhesion:.3g} E* R, {int(keep.sum())} of {deltas.size} approaches on "
