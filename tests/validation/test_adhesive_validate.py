@@ -33,7 +33,8 @@ def test_adhesive_hertz_asperity_against_jkr_at_the_default_grid():
     """At the default grid (256 n = 256^2) the BEM's contact fraction on the rising branch
     is within 3 % of JKR's (the solver's own sphere test measures 2.6-3 % at 256^2 over a
     loading path, a / dx ~ 15-32: the edge placed to a fraction of a spacing), and the
-    adhesive model is JKR itself (to 1e-6: it interpolates its sweep, ~1e-7). The result compares with the adhesive model."""
+    adhesive model is JKR itself (to 1e-6: it interpolates its sweep, ~1e-7). The result
+    compares with the adhesive model."""
     design = _hertz()
     model = mi.Independent(adhesion=W)
     r = mi.validate(design, model=model, loads=3)

@@ -209,9 +209,7 @@ def _validate_adhesive(
             argument="loads",
         )
     if engine != "torch":
-        warnings.warn(
-            f"the adhesive BEM runs in the torch engine, not {engine}", stacklevel=3
-        )
+        warnings.warn(f"the adhesive BEM runs in the torch engine, not {engine}", stacklevel=3)
     result = validate_adhesive(
         design, model, grid=grid, loads=int(loads), p_max=p_max, name=name, device=device
     )
