@@ -40,9 +40,7 @@ def main() -> None:
     design = mi.Design(gamma=g, h=h - h.min(), settings=s)
     p, a = adhesive_cell_curve(w, seed=11, rows=24)
     target = mi.Target(p_star=p, alpha=a, name="held-back")
-    busy = [
-        subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(args.busy)
-    ]
+    busy = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(args.busy)]
     try:
         start = time.perf_counter()
         check = bem_check(
