@@ -133,9 +133,9 @@ def test_made_design_cli(tmp_path, capsys):
     assert main([*args, "--area", "8cm2"]) == 0
     assert "--shear-strength 300kPa" not in capsys.readouterr().out
     pulled = tmp_path / "pull.csv"
-    pulled.write_text("normal_force,friction_force\n-0.1,1.0\n0.5,2\n1.0,3\n")
+    pulled.write_text("normal_force [mN],friction_force [mN]\n-100,1000\n500,2000\n1000,3000\n")
     assert main(["calibrate", str(pulled), "--design", str(path), "--modulus", "2.4MPa"]) == 2
-    assert "normal_force = -0.1" in capsys.readouterr().err
+    assert "got -100 mN" in capsys.readouterr().err  # in the file's units
     bare = d.save(tmp_path / "bare.json")  # no physical block: R and the area unknown
     assert main(["calibrate", str(csv), "--design", str(bare), "--modulus", "2.4MPa"]) == 2
     assert "--radius" in capsys.readouterr().err

@@ -128,7 +128,9 @@ def test_validate_of_an_adhesive_design_says_it_leaves_adhesion_out(tmp_path, ca
     design["model"] = "independent(adhesion=4e-05)"  # as design.json records it
     path = tmp_path / "d.json"
     path.write_text(json.dumps(design))
+    # asked for the adhesionless model (without --physics: the adhesive BEM, issue 52)
     args = ["validate", str(path), "--grid", "48", "--loads", "2", "--workers", "1"]
+    args += ["--physics", "independent"]
     assert main([*args, "--out", str(tmp_path / "run")]) == 0
     err = capsys.readouterr().err
     assert "designed with the adhesive model independent(adhesion=4e-05)" in err

@@ -140,10 +140,15 @@ def test_design_scale_designs_an_offset_law_with_its_area(law_csv, monkeypatch):
     assert any(lo <= sc["value"] <= hi for lo, hi in sc["feasibility"]["ranges"]["area"])
     assert r.error < 0.05
     assert mi.reachability(r.target).reachable
-    # quick scores that tie are settled by full designs: the chosen one is the best of them
+    # quick scores that tie are settled by full designs: the chosen one is the best of them,
+    # its score the curve error plus the uncovered share plus F_0's error (issue 52)
+    from metainterface.scaling.candidates import score, uncovered
+
     finalists, scores = sc["finalists"], sc["finalist_scores"]
     assert len(finalists) == 2 and sc["value"] in finalists
-    assert r.error == pytest.approx(min(scores), rel=1e-9)
+    assert score(r) == pytest.approx(min(scores), rel=1e-9)
+    assert r.f0_error is not None
+    assert score(r) == pytest.approx(r.error + uncovered(r) + r.f0_error, rel=1e-12)
 
 
 def test_design_cli_area_auto_with_work_of_adhesion(law_csv, tmp_path, capsys):

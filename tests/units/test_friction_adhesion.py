@@ -231,3 +231,23 @@ def test_the_notes_are_of_the_design_the_bem_corrected(tmp_path):
     (zero_before,) = [n for n in before.notes if "friction at zero load" in n]
     assert zero != zero_before
     assert "corrected in BEM" in zero and "corrected in BEM" not in zero_before
+
+
+def test_a_work_of_adhesion_without_a_unit_warns_like_the_modulus():
+    """'5' is read as 5 J/m^2, above any soft contact's (issue 52): a unit-slip warning
+    with the likely unit, as --modulus 2.4 gets; a plausible one says nothing."""
+    import warnings
+
+    from metainterface.errors import UnitSlipWarning
+    from metainterface.units.plausible import unit_slips
+
+    said = unit_slips(work_of_adhesion=5.0)
+    assert len(said) == 1 and "5 J/m^2" in said[0] and "(5mJ/m2)" in said[0]
+    assert unit_slips(work_of_adhesion=0.05) == []
+    assert "mJ/m2" in unit_slips(work_of_adhesion=5e-6)[0]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        from metainterface.designer.adhesion import given_adhesion
+
+        given_adhesion(5, "2.4MPa", "0.5mm")
+    assert [w for w in caught if issubclass(w.category, UnitSlipWarning)]

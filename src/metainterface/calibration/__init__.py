@@ -39,6 +39,7 @@ def calibrate_csv(
     design: str | os.PathLike[str] | None = None,
     area: str | float | None = None,
     radius: str | float | None = None,
+    pull_off: str | float | None = None,
 ) -> Calibration:
     """tau and w from a friction CSV (``normal_force,friction_force`` [N], or
     ``normal_force,friction_coefficient``; units in the header), quantities with units.
@@ -47,6 +48,9 @@ def calibrate_csv(
     (``design``, a design.json: :func:`calibrate_design`), whose physical block gives R and
     the patch's nominal area (``area`` and ``radius`` give or override them) and whose
     "model" names the forward model (independent or interacting; none: independent).
+    A sphere test's pull rows (negative normal force, down to pull-off) are used, and
+    ``pull_off`` (the measured pull-off force, e.g. '0.92mN') constrains w. Messages give
+    forces in the file's units. A test the model cannot explain is refused (one line).
     """
     from metainterface.units.law_file import read_friction_csv
     from metainterface.units.quantities import parse_area, parse_length, parse_pressure
@@ -57,7 +61,13 @@ def calibrate_csv(
             argument="--design",
         )
     e = parse_pressure(modulus, option="--modulus")
-    law = read_friction_csv(path, check=False)
+    law = read_friction_csv(path, check=False, pull=True)
+    if pull_off is not None and sphere_radius is None:
+        raise MetainterfaceError(
+            "--pull-off is for a sphere test (--sphere-radius): a made design's pull-off "
+            "depends on the path its patch came by",
+            argument="--pull-off",
+        )
     if sphere_radius is not None:
         if area is not None or radius is not None:
             raise MetainterfaceError(
@@ -65,9 +75,18 @@ def calibrate_csv(
                 "--sphere-radius",
                 argument="--area" if area is not None else "--radius",
             )
+        from metainterface.units.quantities import parse_force
+
         r = parse_length(sphere_radius, option="--sphere-radius")
+        off = None if pull_off is None else parse_force(pull_off, option="--pull-off")
         return calibrate_sphere(
-            law.normal_force, law.friction_force, radius=r, e_star=e, source=str(path)
+            law.normal_force,
+            law.friction_force,
+            radius=r,
+            e_star=e,
+            source=str(path),
+            pull_off=off,
+            unit=law.normal_unit,
         )
     from metainterface.physics.cell import Design
 
@@ -94,4 +113,5 @@ def calibrate_csv(
         radius=float(r),
         source=str(path),
         model=model,
+        unit=law.normal_unit,
     )

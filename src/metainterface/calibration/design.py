@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface.calibration.refuse import refuse
 from metainterface.calibration.sphere import Calibration, check_scales, friction_rows
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.models import ForwardModel
@@ -142,6 +143,7 @@ def calibrate_design(
     radius: float,
     source: str = "friction test",
     model: str | ForwardModel = "independent",
+    unit: tuple[str, float] = ("N", 1.0),
 ) -> Calibration:
     """Fit tau and w to a friction test (K,) [N] of a made design's patch.
 
@@ -149,12 +151,13 @@ def calibrate_design(
     the asperity radius R [m]; model: the forward model the design was made with
     (``independent`` or ``interacting``; design.json's "model"). Loads must be >= 0 (the
     loading branch: a pull depends on the path the patch came by); rows with friction <= 0
-    are left out; at least 3 rows.
+    are left out; at least 3 rows. A test the model cannot explain is refused
+    (``calibration.refuse``); unit: (label, N per unit) of the file's forces, for messages.
     """
     from metainterface.physics.jkr import ADHESION_LIMIT
 
     check_scales((("modulus E*", e_star), ("area", area), ("radius", radius)))
-    fn, ff = friction_rows(normal_force, friction_force, source, loading=True)
+    fn, ff = friction_rows(normal_force, friction_force, source, loading=True, unit=unit)
     unit = e_star * radius  # w [J/m^2] = w [E* R] * unit
 
     adhesive_model(model, 0.0)  # a model that takes no adhesion: one line, before the fit
@@ -204,7 +207,7 @@ def calibrate_design(
     extras = getattr(design, "extras", {}) or {}
     target = extras.get("target") if isinstance(extras.get("target"), dict) else {}
     name = extras.get("name") or target.get("name") or "the design"
-    return Calibration(
+    cal = Calibration(
         tau=tau,
         work=work,
         tau_sigma=tau_sigma,
@@ -217,3 +220,5 @@ def calibrate_design(
         contact=f"the cell of {name}, JKR asperities ({adhesive_model(model, 0.0).label})",
         area=float(area),
     )
+    refuse(cal, fn, ff, source, unit)
+    return cal

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from metainterface.calibration.refuse import refuse
 from metainterface.errors import MetainterfaceError
 
 
@@ -35,6 +36,8 @@ def jkr_contact_radius(
     f = np.asarray(normal_force, dtype=np.float64)
     q = 3.0 * math.pi * work * radius
     inside = 6.0 * math.pi * work * radius * f + q * q
+    # at pull-off inside is 0 but for rounding: a relative 1e-9 below it is pull-off
+    inside = np.where(inside >= -1e-9 * q * q, np.maximum(inside, 0.0), inside)
     with np.errstate(invalid="ignore"):
         cube = radius / (4.0 * e_star / 3.0) * (f + q + np.sqrt(inside))
     return np.where(inside >= 0, np.cbrt(cube), np.nan)
@@ -55,6 +58,7 @@ class Calibration:
     points used; residual_rms: rms relative residual; radius [m], e_star [Pa]: as given.
     contact: what was tested, for the summary ("JKR sphere", or the design's cell with its
     area); area: the nominal area of a made design's patch [m^2] (0 for a sphere).
+    rows counts the measured pull-off force as one where the fit used it.
     """
 
     tau: float
@@ -68,17 +72,30 @@ class Calibration:
     e_star: float
     contact: str = "JKR sphere"
     area: float = 0.0
+    #: w's least possible value [J/m^2]: a pull the test held (the contact had let go at
+    #: any smaller w); the 95 % range does not go below it.
+    work_floor: float = 0.0
+    #: The measured pull-off force [N] the fit used (None: none given).
+    pull_off: float | None = None
+    #: The 95 % ranges of the profile likelihood, {'tau': (lo, hi), 'work': (lo, hi)}
+    #: (w's not floored; None: from the standard errors).
+    ranges: dict[str, tuple[float, float]] | None = None
 
-    def interval(self, level: float = 0.95) -> dict[str, tuple[float, float]]:
+    def interval(
+        self, level: float = 0.95, *, floored: bool = True
+    ) -> dict[str, tuple[float, float]]:
         """{'tau': (lo, hi), 'work': (lo, hi)}: the two-sided ``level`` ranges (Student's t
-        with rows - 2 degrees of freedom); w's floored at 0."""
+        with rows - 2 degrees of freedom); w's floored at ``work_floor`` (>= 0) unless
+        ``floored`` is False."""
         from scipy.stats import t as student
 
         k = float(student.ppf(0.5 + level / 2.0, max(self.rows - 2, 1)))
-        return {
-            "tau": (self.tau - k * self.tau_sigma, self.tau + k * self.tau_sigma),
-            "work": (max(self.work - k * self.work_sigma, 0.0), self.work + k * self.work_sigma),
-        }
+        tau = (self.tau - k * self.tau_sigma, self.tau + k * self.tau_sigma)
+        work = (self.work - k * self.work_sigma, self.work + k * self.work_sigma)
+        if self.ranges is not None and abs(level - 0.95) < 1e-12:
+            tau, work = self.ranges["tau"], self.ranges["work"]
+        lo = max(work[0], self.work_floor) if floored else work[0]
+        return {"tau": tau, "work": (lo, work[1])}
 
     def options(self) -> str:
         """The design options this calibration gives: --shear-strength and --work-of-adhesion."""
@@ -98,6 +115,11 @@ class Calibration:
             f"fit: {self.rows} rows, rms relative residual {100 * self.residual_rms:.2g} % "
             f"({self.contact}, R = {self.radius * 1e3:.4g} mm, E* = {self.e_star / 1e6:.4g} MPa"
             + (f", area {self.area * 1e4:.4g} cm^2)" if self.area else ")"),
+            *(
+                [f"pull-off {self.pull_off * 1e3:.4g} mN used as a row of the fit"]
+                if self.pull_off is not None
+                else []
+            ),
             f"use: {self.options()}",
         ]
 
@@ -119,8 +141,16 @@ class Calibration:
             "sphere_radius_m" if not self.area else "radius_m": self.radius,
             "e_star_pa": self.e_star,
             **({"area_m2": self.area} if self.area else {}),
+            **({"pull_off_n": self.pull_off} if self.pull_off is not None else {}),
+            **({"work_of_adhesion_floor_j_m2": self.work_floor} if self.work_floor else {}),
             "options": self.options(),
         }
+
+
+#: The relative precision of a test's loads (a load cell's resolution, a file's digits): a
+#: pull within it beyond a w's pull-off force is read at pull-off, so w's floor from the
+#: pulls the test held is that much below the largest pull's w.
+LOAD_PRECISION = 1e-3
 
 
 def check_scales(named: tuple[tuple[str, object], ...]) -> None:
@@ -131,17 +161,24 @@ def check_scales(named: tuple[tuple[str, object], ...]) -> None:
 
 
 def friction_rows(
-    normal_force: np.ndarray, friction_force: np.ndarray, source: str, *, loading: bool = False
+    normal_force: np.ndarray,
+    friction_force: np.ndarray,
+    source: str,
+    *,
+    loading: bool = False,
+    unit: tuple[str, float] = ("N", 1.0),
 ) -> tuple[np.ndarray, np.ndarray]:
     """A friction test's rows (K,) [N] as float arrays, those with both finite and friction
     > 0 kept; a one-line error for fewer than 3, and (``loading``: a made design's loading
-    branch) for a negative load."""
+    branch) for a negative load, in the file's ``unit`` (label, N per unit)."""
+    from metainterface.units.law_file import in_unit
+
     fn = np.asarray(normal_force, dtype=np.float64)
     ff = np.asarray(friction_force, dtype=np.float64)
     if loading and np.any(fn[np.isfinite(fn)] < 0):
         raise MetainterfaceError(
             f"{source}: a made design's calibration takes loads >= 0 (the loading branch), "
-            f"got {float(np.nanmin(fn)):g} N"
+            f"got {in_unit(float(np.nanmin(fn)), unit)}"
         )
     keep = np.isfinite(fn) & np.isfinite(ff) & (ff > 0)
     fn, ff = fn[keep], ff[keep]
@@ -160,65 +197,62 @@ def calibrate_sphere(
     radius: float,
     e_star: float,
     source: str = "friction test",
+    pull_off: float | None = None,
+    unit: tuple[str, float] = ("N", 1.0),
 ) -> Calibration:
     """Fit tau and w to a sphere's friction test (K,) [N], radius R [m], E* [Pa].
 
-    Needs at least 3 rows with friction > 0, loads finite (negative ones, a pull, allowed).
+    Needs at least 3 rows with friction > 0, loads finite: pull rows (a negative load, down
+    to pull-off) are used, and a pull the sphere held bounds w from below (w >= 2 |F_n| /
+    (3 pi R)). ``pull_off``: the measured pull-off force [N] (its magnitude), a further
+    residual ln(3/2 pi w R / F_off) weighted as one row. The 95 % ranges are the profile
+    likelihood's (``calibration.profile``): a linearised covariance fails where a row sits
+    at pull-off, where friction's derivative in w is infinite. Refuses a test the JKR
+    model cannot explain (``calibration.refuse``). unit: (label, N per unit) of the file's
+    forces, for messages.
     """
-    from scipy.optimize import least_squares
+    from metainterface.calibration.profile import fit_profile
+    from metainterface.units.law_file import in_unit
 
     check_scales((("sphere radius", radius), ("modulus E*", e_star)))
-    fn, ff = friction_rows(normal_force, friction_force, source)
-    # scales: tau from the largest load's Hertz area; w from the force scale F / (pi R)
-    a_top = jkr_contact_radius(np.array([max(fn.max(), 1e-300)]), 0.0, radius, e_star)[0]
-    tau0 = float(ff.max() / (math.pi * a_top**2)) if a_top > 0 else 1.0
-    w_scale = max(float(np.abs(fn).max()), 1e-300) / (math.pi * radius)
-
-    def residual(x: np.ndarray) -> np.ndarray:
-        model = sphere_friction(fn, x[0] * tau0, x[1] * w_scale, radius, e_star)
-        return np.where(np.isfinite(model), model / ff - 1.0, 10.0)
-
-    best = None
-    for w_start in (0.0, 0.01, 0.1, 1.0):  # the fit is not convex in w: a few starts
-        sol = least_squares(
-            residual,
-            x0=[1.0, w_start],
-            bounds=([1e-12, 0.0], [np.inf, np.inf]),
-            method="trf",
-            xtol=1e-14,
-            ftol=1e-14,
-            gtol=1e-14,
+    fn, ff = friction_rows(normal_force, friction_force, source, unit=unit)
+    off = None
+    if pull_off is not None:
+        check_scales((("pull-off force", abs(float(pull_off))),))
+        off = abs(float(pull_off))
+    # a pull held: w at least the one whose pull-off it is (else the contact had let go),
+    # less the loads' precision (a row at pull-off is read at it)
+    floor = max(-float(fn.min()), 0.0) / (1.5 * math.pi * radius) * (1 - LOAD_PRECISION)
+    if off is not None and floor > off / (1.5 * math.pi * radius) * (1 + 1e-9):
+        raise MetainterfaceError(
+            f"{source}: a row pulls {in_unit(-float(fn.min()), unit)}, more than the pull-off "
+            f"force {in_unit(off, unit)} given: the sphere would have come off"
         )
-        if best is None or sol.cost < best.cost:
-            best = sol
-    assert best is not None
-    x, cost = best.x, float(best.cost)
-    # Without adhesion friction is linear in tau, so the best fit on the bound w = 0 has a
-    # closed form; the solver stops short of it there (friction grows as sqrt(w): a test
-    # without adhesion read tau 1e-6 off, w 5e-14 with scipy 1.17). Kept where it fits
-    # better; the covariance is the solver's, next to it.
-    ratio = sphere_friction(fn, tau0, 0.0, radius, e_star) / ff
-    if np.all(np.isfinite(ratio)) and np.sum(ratio**2) > 0:
-        plain = np.array([float(np.sum(ratio) / np.sum(ratio**2)), 0.0])
-        plain_cost = 0.5 * float(np.sum(residual(plain) ** 2))
-        if plain_cost < cost:
-            x, cost = plain, plain_cost
-    dof = max(fn.size - 2, 1)
-    s2 = 2.0 * cost / dof
-    jac = best.jac / np.array([tau0, w_scale])[None]  # d residual / d (tau, w)
-    try:
-        cov = np.linalg.inv(jac.T @ jac) * s2
-    except np.linalg.LinAlgError:
-        cov = np.full((2, 2), np.inf)
-    tau, work = float(x[0] * tau0), float(x[1] * w_scale)
-    return Calibration(
-        tau=tau,
-        work=work,
-        tau_sigma=float(math.sqrt(max(cov[0, 0], 0.0))),
-        work_sigma=float(math.sqrt(max(cov[1, 1], 0.0))),
-        covariance=cov,
-        rows=int(fn.size),
-        residual_rms=float(math.sqrt(2.0 * cost / fn.size)),
+
+    def shape(w: float) -> np.ndarray:  # friction per unit tau over the measured friction
+        off_w = -1.5 * math.pi * w * radius
+        at = np.where((fn < off_w) & (fn >= off_w * (1 + LOAD_PRECISION)), off_w, fn)
+        return sphere_friction(at, 1.0, w, radius, e_star) / ff
+
+    def extra(w: float) -> np.ndarray:  # the pull-off force, model over measured: a row
+        return np.array([1.5 * math.pi * w * radius / off]) if off else np.zeros(0)
+
+    scale = max(float(np.abs(fn).max()), off or 0.0, 1e-300) / (math.pi * radius)
+    fit = fit_profile(shape, extra, floor=floor, scale=scale, extra_rows=int(off is not None))
+    cal = Calibration(
+        tau=fit.tau,
+        work=fit.work,
+        tau_sigma=fit.tau_sigma,
+        work_sigma=fit.work_sigma,
+        covariance=fit.covariance,
+        rows=int(fn.size + (off is not None)),
+        residual_rms=fit.rms,
         radius=float(radius),
         e_star=float(e_star),
+        work_floor=floor,
+        pull_off=off,
+        ranges=fit.ranges,
     )
+    hertz = fit.tau_at(0.0) if floor == 0 and off is None else None
+    refuse(cal, fn, ff, source, unit, hertz_tau=hertz)
+    return cal

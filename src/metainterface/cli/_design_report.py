@@ -12,6 +12,9 @@ def table(args: argparse.Namespace, results: list) -> None:
         f"{'target':<{width}}{'method':<12}{'zero-shot':>11}{'error':>11}{'coverage':>10}"
         f"{'carrying':>10}{'seconds':>9}"
     )
+    offset = any(r.f0_error is not None for r in results)
+    if offset:  # an offset law: F_0 beside the curve error, part of what a design meets
+        head += f"{'F_0':>11}"
     checked = [r for r in results if r.bem is not None]
     if checked:
         head += f"{'BEM':>11}{'+-':>9}{'BEM s':>8}"
@@ -26,6 +29,9 @@ def table(args: argparse.Namespace, results: list) -> None:
             f"{100 * r.error:>9.3g} %{100 * r.coverage:>8.3g} %"
             f"{f'{r.carrying}/{r.design.n_asperities}':>10}{r.seconds:>9.2f}"
         )
+        if offset:
+            f0 = "" if r.f0_error is None else f"{100 * r.f0_error:.3g} %"
+            line += f"{f0:>11}"
         if r.robust:
             line += f"{100 * r.robust['error_median']:>9.3g} %{100 * r.robust['error_p95']:>9.3g} %"
         if r.printable:
@@ -36,6 +42,8 @@ def table(args: argparse.Namespace, results: list) -> None:
             line += f"{100 * r.bem.bem_error:>9.3g} %{acc:>9}{_bem_seconds(r):>8.1f}"
         if r.forced:
             line += "  FORCED (out of reach)"
+        if r.f0_met is False:
+            line += "  F_0 UNMET"
         print(line)
     if args.robust:
         print("error: the nominal design's; made p50/p95: of cells made with the errors given")
@@ -48,6 +56,11 @@ def table(args: argparse.Namespace, results: list) -> None:
         "error: sqrt(fit^2 + (1 - coverage)^2), fit over the loads the design reaches; "
         "coverage: the share of the target's load range it reaches"
     )
+    if offset:
+        print(
+            "F_0: the design's friction at zero load against the law's (off by, relative); "
+            "met within 2 %"
+        )
     others = [r for r in results if r.zero_shot_from not in ("", "surrogate")]
     if others:  # targets without stiffness: say which reading of the target won
         said = "; ".join(f"{r.target.name}: {r.zero_shot_from}" for r in others)

@@ -15,7 +15,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "on the material (Bowden-Tabor friction F_f = tau A on a JKR contact), or of a made "
         "design (--design: its cell's real area under the adhesive model, load control). The "
         "CSV is a friction law (normal_force,friction_force in N, or "
-        "normal_force,friction_coefficient; units in the header). The result feeds design's "
+        "normal_force,friction_coefficient; units in the header); a sphere test's pull rows "
+        "(negative normal force, down to pull-off) are used. A test the model cannot explain "
+        "(friction falling with load, a fit far outside the test's scatter, a range reaching "
+        "tau <= 0 or w < 0) is refused: exit 2, nothing written. The result feeds design's "
         "--shear-strength and --work-of-adhesion.",
     )
     p.add_argument("friction_csv", help="the friction test, one row per normal force")
@@ -36,6 +39,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--radius",
         help="with --design: the asperity radius R, e.g. 0.5mm (default: the design.json's)",
     )
+    p.add_argument(
+        "--pull-off",
+        help="a sphere test: the measured pull-off force, e.g. 0.92mN (its magnitude); it "
+        "constrains w as one more row of the fit",
+    )
     p.add_argument("--out", help="also write the calibration as JSON here")
     p.set_defaults(func=run)
 
@@ -52,6 +60,7 @@ def run(args: argparse.Namespace) -> int:
         design=args.design,
         area=args.area,
         radius=args.radius,
+        pull_off=args.pull_off,
     )
     for line in cal.summary():
         print(line)

@@ -20,7 +20,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "and design.png into --out (one folder per target when there are several). Each "
         "design is then checked in the boundary element method (BEM) and its BEM error to the "
         "target reported beside the model's; exit status 3 when a design's BEM error is above "
-        "--max-bem-error (the files are written all the same), 2 on bad input.",
+        "--max-bem-error or, for a friction law with an offset (adhesion), its friction at "
+        "zero load F_0 is more than 2 % off the law's (the files are written all the same), "
+        "2 on bad input.",
     )
     _args.target_arguments(p)
     _args.unit_arguments(p)
@@ -198,7 +200,13 @@ def run(args: argparse.Namespace) -> int:
             f"--max-bem-error {100 * r.bem.max_error:g} %: the made surface will miss the "
             f"target (the model's error at the same loads: {100 * r.bem.model_error:.3g} %)"
         )
-    return 3 if high else 0
+    unmet = [r for r in results if r.f0_met is False]
+    for r in unmet:  # an offset law's F_0: what a gripper is specified by
+        print(
+            f"{r.target.name}: friction at zero load F_0 is {100 * r.f0_error:.3g} % off the "
+            "law's, above 2 %: the design does not meet the law's offset"
+        )
+    return 3 if high or unmet else 0
 
 
 def _run(args: argparse.Namespace, targets: list, options: dict) -> list:

@@ -102,9 +102,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--physics",
         choices=MODEL_NAMES,
-        default=DEFAULT_MODEL,
+        default=None,
         help="forward model that sets the loads and alpha_model: the paper's independent "
-        "asperities (default) or with their elastic interaction; both are reported",
+        f"asperities (default: {DEFAULT_MODEL}) or with their elastic interaction; both are "
+        "reported. A design made with adhesion (its design.json's model) is, without "
+        "--physics, solved in the adhesive (JKR-limit) BEM by approach and compared with "
+        "its adhesive model on the rising-force branch",
     )
     p.add_argument(
         "--engine",
@@ -139,6 +142,12 @@ def run(args: argparse.Namespace) -> int:
         device=args.device,
     )
     rel = {name: result.alpha_bem / a - 1.0 for name, a in result.alpha_by_model.items()}
+    if result.model.adhesion:  # the adhesive BEM: against the adhesive model only
+        rel = {result.model.label: result.rel_err}
+        print(
+            f"adhesive BEM (JKR limit) by approach: {len(result.p_star)} states on the "
+            f"rising-force branch, against {result.model.label}"
+        )
     k = len(result.p_star)
     print(
         f"{args.out}: {k} loads on {result.grid}x{result.grid} ({result.engine} engine), "

@@ -23,6 +23,7 @@ def given_adhesion(
     modulus and radius (both needed: w is dimensionless only against E* R); 0 if None."""
     if work_of_adhesion is None:
         return 0.0
+    from metainterface.units.plausible import warn_unit_slips
     from metainterface.units.quantities import (
         parse_length,
         parse_pressure,
@@ -30,6 +31,7 @@ def given_adhesion(
     )
 
     w = parse_work_of_adhesion(work_of_adhesion, option="work_of_adhesion")
+    warn_unit_slips(work_of_adhesion=w)  # '5' is 5 J/m^2: likely meant mJ/m^2
     if modulus is None or radius is None:
         raise MetainterfaceError(
             "work_of_adhesion needs the modulus and radius too (w / (E* R) sets the contact)",

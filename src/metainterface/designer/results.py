@@ -3,6 +3,7 @@ that draws and saves itself (design.json, curve.csv, design.png)."""
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 from dataclasses import dataclass, field
@@ -121,6 +122,23 @@ class DesignResult(ReachCounts):
     def _reach_of(self) -> tuple[ForwardModel, tuple[np.ndarray, np.ndarray]]:
         return self.model, (self.target.p_star, self.target.alpha)
 
+    @functools.cached_property
+    def f0_error(self) -> float | None:
+        """An offset law's design: |F_0 / F_0,law - 1|, its friction at zero load against
+        the law's (under the model it was designed with); None for any other target."""
+        from metainterface.inverse.offset import f0_error
+
+        d = self.design
+        return f0_error(self.target, d.gamma, d.h, d.settings, self.model)
+
+    @property
+    def f0_met(self) -> bool | None:
+        """F_0 within ``inverse.offset.F0_MEET`` (2 %) of the law's; None without an offset."""
+        from metainterface.inverse.offset import F0_MEET
+
+        e = self.f0_error
+        return None if e is None else e <= F0_MEET
+
     @property
     def bem_error(self) -> float | None:
         """The BEM curve's relative error to the target (None when not verified)."""
@@ -191,6 +209,11 @@ class DesignResult(ReachCounts):
             "relative_error": self.error,
             "error_definition": "sqrt(fit^2 + (1 - coverage)^2)",
             "coverage": self.coverage,
+            **(
+                {"f0_error": self.f0_error, "f0_met": self.f0_met}
+                if self.f0_error is not None
+                else {}
+            ),
             "idle_asperities": list(self.idle),
             "carrying_asperities": self.carrying,
             **({"forced": True} if self.forced else {}),
@@ -278,7 +301,14 @@ class DesignResult(ReachCounts):
         return (
             f"DesignResult({forced}target={self.target.name!r}, method={self.method!r}, "
             f"model={self.model.label!r}, error={_percent(self.error)}, "
-            f"coverage={_percent(self.coverage)}, carrying {self.carrying} of "
+            + (
+                ""
+                if self.f0_error is None
+                else f"F_0 off by {_percent(self.f0_error)}"
+                + ("" if self.f0_met else " (UNMET: above 2 %)")
+                + ", "
+            )
+            + f"coverage={_percent(self.coverage)}, carrying {self.carrying} of "
             f"{self.design.n_asperities} asperities, "
             f"zero-shot {_percent(self.initial_error)}, {self.seconds:.2f} s{made}, "
             f"design={self.design!r}{note})"

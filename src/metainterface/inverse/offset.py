@@ -20,6 +20,7 @@ so. ``benchmarks/bench_offset_f0.py`` measures it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import replace
 from typing import TYPE_CHECKING
@@ -49,6 +50,12 @@ OFFSET_SLACK = 0.1
 OFFSET_FLOOR = 0.001
 #: An F_0 this near the law's (relative) counts as met: the curve error then decides.
 F0_TOL = 0.01
+#: What a design of an offset law meets (issue 52): F_0 within 2 % of the law's, beside
+#: the curve within 2 %. The polish may trade curve error up to ``CURVE_MEET`` for F_0 (a
+#: gripper is specified by its friction at zero load more than by any other point), and a
+#: design whose F_0 is further off says so in its summary and exit status.
+F0_MEET = 0.02
+CURVE_MEET = 0.02
 #: The contact counts tried: the design's own and up to this many more or fewer.
 COUNT_STEPS = 2
 
@@ -144,7 +151,9 @@ def offset_polish(
         r = results[i]
         mine = (owner_t == j).nonzero(as_tuple=True)[0]
         before = missed[i]
-        within = err[mine] <= max(r.error * (1 + OFFSET_SLACK), r.error + OFFSET_FLOOR)
+        # the curve may get worse by the slack, or up to CURVE_MEET where F_0 then meets
+        bound = max(r.error * (1 + OFFSET_SLACK), r.error + OFFSET_FLOOR)
+        within = (err[mine] <= bound) | ((err[mine] <= CURVE_MEET) & (miss[mine] <= F0_MEET))
         # nearest F_0 first, all within F0_TOL counting as met; then the smaller error
         keys = [(max(float(miss[k]), F0_TOL), float(err[k]), int(k)) for k in mine[within]]
         if not keys or min(keys)[:2] >= (max(before, F0_TOL), r.error):
@@ -162,10 +171,26 @@ def offset_polish(
 
 def _f0_miss(result: DesignResult, model: ForwardModel) -> float:
     """The design's F_0 relative error |alpha(0) / alpha_t(0) - 1|."""
-    t = result.target
-    gamma = torch.as_tensor(np.asarray(result.gamma), dtype=DTYPE)[None]
-    h = torch.as_tensor(np.asarray(result.h), dtype=DTYPE)[None]
+    miss = f0_error(result.target, result.gamma, result.h, result.settings, model)
+    return math.inf if miss is None else miss
+
+
+def f0_error(
+    target: Target, gamma: np.ndarray, h: np.ndarray, settings: CellSettings, model: ForwardModel
+) -> float | None:
+    """|F_0,design / F_0,law - 1| of a design (gamma, h (N,)) of an offset law's target
+    (F_0 > 0 given by the law, not extrapolated) under ``model``; None for any other target
+    or a model without adhesion (no friction at zero load). F_0: the model at zero load,
+    just after the cell snaps in (``ZERO_LOAD``, the target's first point)."""
+    t = target
+    if not (t.p_star.size and t.p_star[0] == 0 and t.alpha[0] > 0) or extrapolated(t):
+        return None
+    if not model.adhesion:
+        return None
+    g = torch.as_tensor(np.asarray(gamma), dtype=DTYPE)[None]
+    hh = torch.as_tensor(np.asarray(h), dtype=DTYPE)[None]
     p = torch.as_tensor(np.asarray(t.p_star), dtype=DTYPE)[None]
     with torch.no_grad():
-        alpha, _ = model.alpha_at(gamma, h, result.settings, p, exact=True)
-    return abs(float(alpha[0, 0]) / float(t.alpha[0]) - 1)
+        alpha, _ = model.alpha_at(g, hh, settings, p, exact=True)
+    value = abs(float(alpha[0, 0]) / float(t.alpha[0]) - 1)
+    return value if math.isfinite(value) else math.inf

@@ -282,7 +282,15 @@ def _advice(p, alpha, lo, hi, within, f_reach, fn, tau, units) -> str:
         s_lo = float(np.max(low / (a + slack)))
         big = a > slack
         s_hi = float(np.min(high[big] / (a[big] - slack))) if big.any() else math.inf
-        if s_lo <= s_hi:
+        if s_lo <= s_hi and not math.isfinite(s_hi):  # no upper bound on the scaling
+            if units:
+                out.append(
+                    f"A shear strength tau of at most {_pa(tau / s_lo)} would reach it "
+                    f"(or its friction scaled by {s_lo:.3g} or more)"
+                )
+            else:
+                out.append(f"Its alpha scaled by {s_lo:.3g} or more would reach it")
+        elif s_lo <= s_hi:
             if units:
                 out.append(
                     f"A shear strength tau of {_pa(tau / s_hi)}-{_pa(tau / s_lo)} would reach it "
@@ -292,7 +300,13 @@ def _advice(p, alpha, lo, hi, within, f_reach, fn, tau, units) -> str:
                 out.append(f"Its alpha scaled by {_fmt(s_lo, s_hi)} would reach it")
         else:
             out.append("No single tau/E* fits its shape at these loads: change the law")
-    if not within.all():
+    if not within.all() and not f_reach > 0:  # no cell carries any load: no factor says it
+        out.append(
+            "no cell of this family carries any of its load at this scale"
+            if units
+            else "no cell of this family carries any of its P*"
+        )
+    elif not within.all():
         grow = float(fn.max() / f_reach)
         out.append(
             f"its largest load needs a {grow:.3g}x larger area"

@@ -19,6 +19,7 @@ from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
 from metainterface.scaling import search as _scale
+from metainterface.scaling.candidates import _candidates, _closer, _coarse, score
 
 #: Candidate scales designed quickly before the chosen one is designed in full.
 CANDIDATES = 5
@@ -108,6 +109,7 @@ def _law_and_scale(
     given["work_of_adhesion"] = work
     warn_unit_slips(
         **{k: given[k] for k in ("modulus", "shear_strength", "radius") if k != var},
+        work_of_adhesion=work,
     )
     return law, lf, given, var, span
 
@@ -199,69 +201,6 @@ def _feasible(
     return given, fs
 
 
-def _candidates(fs: _scale.FeasibleScale, var: str, count: int) -> np.ndarray:
-    """Values of ``var`` to design: spread (in log) over its feasible ranges, else around
-    the least-violating value."""
-    spans = fs.ranges[var]
-    lo_b, hi_b = fs.bounds[var]
-    if spans and _coarse(fs, var):  # the grid points tested, spread over the widest range
-        lo, hi = max(spans, key=lambda s: s[1] / s[0])
-        grid = _scale.scan_grid((lo_b, hi_b), True)
-        inside = grid[(grid >= lo * (1 - 1e-9)) & (grid <= hi * (1 + 1e-9))]
-        pick = np.unique(np.round(np.linspace(0, inside.size - 1, min(count, inside.size))))
-        return inside[pick.astype(int)]
-    if spans:
-        lo, hi = spans[0][0], spans[-1][1]
-        if len(spans) > 1:  # several ranges: the widest one
-            lo, hi = max(spans, key=lambda s: s[1] / s[0])
-        # keep off the envelope's edges, where the pointwise estimate is least sure
-        inner = (hi / lo) ** 0.1
-        return np.geomspace(lo * inner, hi / inner, count) if hi / lo > 1.01 else np.array([lo])
-    b = fs.best[var]
-    return np.clip(np.geomspace(b / 1.3, b * 1.3, count), lo_b, hi_b)
-
-
-def _coarse(fs: _scale.FeasibleScale, var: str) -> bool:
-    """Whether ``var`` was searched on the coarse grid (the modulus with adhesion): its
-    candidates are then the grid points tested, not values between them."""
-    return bool(fs.work_of_adhesion) and var == "modulus"
-
-
-def uncovered(result: Any) -> float:
-    """The share of a target's pressure range its design does not reach by Delta_max.
-
-    The relative curve error holds a design's alpha at its last value past its reach, so a
-    design that stops short of the law can score well; the scale search adds this share to
-    the error, so that it prefers a scale whose design carries the whole law."""
-    import torch
-
-    g, h = result.design.tensors()
-    with torch.no_grad():
-        zero = torch.zeros(1, 1, dtype=g.dtype)
-        _, p_max = result.model.alpha_at(g, h, result.design.settings, zero)
-    top = float(result.target.p_star_max)
-    return max(0.0, 1.0 - float(p_max[0]) / top) if top > 0 else 0.0
-
-
-def _closer(values: np.ndarray, errors: np.ndarray) -> np.ndarray:
-    """Second-round candidates: the geometric midpoints between the best value and its
-    neighbours, and the vertex of the parabola through the three in (log value, log error)
-    where it falls between them (a step of golden-section-like refinement, on a batch)."""
-    k = int(np.argmin(errors))
-    lo, hi = max(k - 1, 0), min(k + 1, values.size - 1)
-    x = np.log(values)
-    out = [float(np.exp(0.5 * (x[lo] + x[k]))), float(np.exp(0.5 * (x[k] + x[hi])))]
-    if 0 < k < values.size - 1:
-        y = np.log(np.maximum(errors[lo : hi + 1], 1e-12))
-        c = np.polyfit(x[lo : hi + 1], y, 2)
-        if c[0] > 0:
-            v = -c[1] / (2 * c[0])
-            if x[lo] < v < x[hi]:
-                out.append(float(np.exp(v)))
-    out = np.unique([v for v in out if not np.isclose(v, values, rtol=1e-3).any()])
-    return np.asarray(out, dtype=np.float64)
-
-
 @uses_threads()
 def design_scale(
     law: str | os.PathLike[str] | Any,
@@ -289,8 +228,9 @@ def design_scale(
     quick scores within ``TIE`` of the best tie: the best ``FINALISTS`` are designed in full
     first (without the BEM check) and the best of those is chosen.
 
-    A candidate's score is its quick design's relative curve error plus the share of the
-    law's pressure range the design does not reach by Delta_max.
+    A candidate's score (``score``) is its quick design's relative curve error plus the
+    share of the law's pressure range the design does not reach by Delta_max, plus, for an
+    offset law, its F_0's relative error.
 
     work_of_adhesion: w ('50mJ/m2' or J/m^2) for an adhesive contact: the law may have
     F_f(0) > 0, the scale search tests adhesive cells (:func:`feasible_scale`) and every
@@ -368,6 +308,8 @@ def design_scale(
         # with its prediction in one batch, not after it
         hedge_error=0.0,
     )
+    if given["work_of_adhesion"]:  # an offset law's F_0 is polished in the quick round too
+        effort = replace(effort, refine_settings=replace(QUICK, offset=True))
     quick_opts = {k: v for k, v in options.items() if k in ("method", "model")}
 
     def quick(vals: np.ndarray) -> np.ndarray:
@@ -385,7 +327,7 @@ def design_scale(
                 **quick_opts,
             )
         ]
-        return np.array([r.error + uncovered(r) for r in made])
+        return np.array([score(r) for r in made])
 
     errors = quick(values)
     # a second round between the best and its neighbours (not on a coarse grid: its points
@@ -423,7 +365,7 @@ def design_scale(
     if len(tied) > 1 and given["work_of_adhesion"]:
         for i in tied:
             r = full(float(values[i]), {"verify": False, "out": None}, {})
-            finals[float(values[i])] = r.error + uncovered(r)
+            finals[float(values[i])] = score(r)
     chosen = min(finals, key=finals.__getitem__) if finals else float(values[order[0]])
     scores = {
         "candidates": [float(v) for v in values],
@@ -436,15 +378,18 @@ def design_scale(
 
 
 def scale_line(result: Any) -> str | None:
-    """One line on the scale a design chose, in the user's units, or None."""
+    """One line on the scale a design chose, in the user's units, or None. The range is
+    the feasibility line's (printed before it), not repeated here: one range on screen."""
     sc = result.target.meta.get("scale") if isinstance(result.target.meta, dict) else None
     if not sc:
         return None
     fmt = _scale.fmt_area if sc["variable"] == "area" else _scale.fmt_pressure
     what = {"area": "area", "modulus": "E*", "shear_strength": "tau"}[sc["variable"]]
     n, side = sc["n_cells"], sc["tiles_per_side"]
+    f0 = getattr(result, "f0_error", None)
+    met = "" if f0 is None or f0 <= 0.02 else ", UNMET: above 2 %"
     return (
-        f"{result.target.name}: chose {what} = {fmt(sc['value'])} of "
-        f"{fmt(sc['searched'][0])}-{fmt(sc['searched'][1])} ({len(sc['candidates'])} "
+        f"{result.target.name}: chose {what} = {fmt(sc['value'])} ({len(sc['candidates'])} "
         f"candidates), {n:.4g} cells ({side}x{side} tiles), error {100 * result.error:.3g} %"
+        + ("" if f0 is None else f", F_0 off by {100 * f0:.3g} %{met}")
     )

@@ -182,8 +182,11 @@ def _fmt(var: str, v: float) -> str:
 
 
 def _span(var: str, lo: float, hi: float) -> str:
-    """'6.1-9.8 cm^2' (one unit) or '800 kPa-1.2 MPa'."""
+    """'6.1-9.8 cm^2' (one unit) or '800 kPa-1.2 MPa'; 'about 18 MPa' where the two read
+    alike (a range one grid point wide: '18-18 MPa' said nothing)."""
     a, b = _fmt(var, lo), _fmt(var, hi)
+    if a == b:
+        return f"about {a}"
     ua, ub = a.split(" ", 1)[1], b.split(" ", 1)[1]
     return f"{a.split(' ', 1)[0]}-{b}" if ua == ub else f"{a}-{b}"
 

@@ -45,6 +45,7 @@ from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
 from metainterface.physics.registry import get_model
 from metainterface.plots import plot_validation, save_figure
+from metainterface.validation.adhesive_validate import is_adhesive, validate_adhesive
 from metainterface.validation.bem import (
     MAX_ITER,
     TOLERANCE,
@@ -140,6 +141,9 @@ def validate(
             raise MetainterfaceError("design must be a Design or a design file path")
         design = Design.load(design)
     fm = get_model(model)
+    sticky = is_adhesive(design, None if model is None else fm)
+    if sticky is not None:  # the adhesive BEM against the adhesive model
+        return _validate_adhesive(design, sticky, grid, loads, p_max, name, out, engine, device)
     warn_adhesive([(name, design)], fm)
     if p_max is not None:
         k = _checks.whole("loads", loads, low=1, high=10_000)
@@ -182,6 +186,36 @@ def validate(
         with output_set():  # all of a result's files, or none
             write_result(result, out, command="validate", jobs=jobs)
             write_models(result, Path(out) / "models.csv")
+    return result
+
+
+def _validate_adhesive(
+    design: Design,
+    model: ForwardModel,
+    grid: int | None,
+    loads: Any,
+    p_max: float | None,
+    name: str,
+    out: str | os.PathLike[str] | None,
+    engine: str,
+    device: str,
+) -> ValidationResult:
+    """``validate`` of a design with adhesion (``validation.adhesive_validate``): by
+    approach, so ``loads`` is a count; the torch engine (the JKR-limit solver's)."""
+    if not isinstance(loads, int | np.integer) or isinstance(loads, bool):
+        raise MetainterfaceError(
+            "an adhesive design is validated by approach (its loads are where the rising "
+            "branch lands): give loads as a count",
+            argument="loads",
+        )
+    if engine != "torch":
+        warnings.warn(f"the adhesive BEM runs in the torch engine, not {engine}", stacklevel=3)
+    result = validate_adhesive(
+        design, model, grid=grid, loads=int(loads), p_max=p_max, name=name, device=device
+    )
+    if out is not None:
+        with output_set():
+            write_result(result, out, command="validate", jobs=1)
     return result
 
 

@@ -400,10 +400,10 @@ def friction_target_in_units(
     e_star = parse_pressure(modulus, option=name("modulus"))
     r = parse_length(radius, option=name("radius"))
     a = parse_area(area, option=name("area"))
-    warn_unit_slips(modulus=e_star, shear_strength=tau, radius=r)
     w = 0.0
     if work_of_adhesion is not None:
         w = parse_work_of_adhesion(work_of_adhesion, option=name("work_of_adhesion"))
+    warn_unit_slips(modulus=e_star, shear_strength=tau, radius=r, work_of_adhesion=w)
     return friction_target(
         law,
         shear_strength=tau,

@@ -33,28 +33,41 @@ class FrictionLaw:
     friction_force: np.ndarray
     rows: np.ndarray
     source: str = "friction law"
+    #: The file's force units, for messages in them: (label, newtons per unit) of the
+    #: normal force's and the friction force's columns (``N``, 1.0 where none is given).
+    normal_unit: tuple[str, float] = ("N", 1.0)
+    friction_unit: tuple[str, float] = ("N", 1.0)
 
 
 #: Column names of a friction CSV (each may carry a unit in its header: ``normal_force [mN]``).
 FRICTION_NAMES = ("normal_force", "friction_force", "friction_coefficient")
 
 
-def _forces(table: Table, name: str) -> np.ndarray:
-    """A force column in newtons, converted from the unit its header gives (none: N)."""
+def _unit(table: Table, name: str) -> tuple[str, float]:
+    """(label, newtons per unit) of a force column, from the unit its header gives (none: N)."""
     from metainterface.units.quantities import force_unit
 
     unit = table.unit(name)
     where = f"{table.path}: column {name}" + ("" if unit is None else f" [{unit}]")
-    return table.column(name) * force_unit(unit, where=where)
+    label = unit.strip() if unit is not None and unit.strip() else "N"
+    return label, force_unit(unit, where=where)
 
 
-def read_friction_csv(path: str | os.PathLike[str], *, check: bool = True) -> FrictionLaw:
+def in_unit(value: float, unit: tuple[str, float]) -> str:
+    """A force [N] as the file writes it: ``-0.92363 mN`` for ``unit`` ("mN", 1e-3)."""
+    return f"{value / unit[1]:.6g} {unit[0]}"
+
+
+def read_friction_csv(
+    path: str | os.PathLike[str], *, check: bool = True, pull: bool = False
+) -> FrictionLaw:
     """Read a friction curve: ``normal_force,friction_force`` or ``...,friction_coefficient``.
 
     Forces in newtons unless the header gives a unit (``normal_force [mN]``,
     ``friction_force (kN)``, ``normal_force_uN``: any force unit pint reads); the coefficient
     dimensionless. Separators, decimal commas, comments: :func:`read_table`. Every value finite
-    and >= 0; with ``check`` also the rows as a law (normal force strictly increasing,
+    and >= 0 (``pull``: a negative normal force, a pull, allowed, as a sphere test down to
+    pull-off has); with ``check`` also the rows as a law (normal force strictly increasing,
     friction never decreasing, no friction at zero load), else the rows as measured (any
     order, repeats).
     """
@@ -71,10 +84,13 @@ def read_friction_csv(path: str | os.PathLike[str], *, check: bool = True) -> Fr
             f"{path}: missing column(s); the header must be normal_force,friction_force (N) or "
             f"normal_force,friction_coefficient (found {','.join(header) or 'nothing'})"
         )
-    normal = _forces(table, "normal_force")
+    n_unit = _unit(table, "normal_force")
+    normal = table.column("normal_force") * n_unit[1]
     if "friction_force" in header:
-        friction = _forces(table, "friction_force")
+        f_unit = _unit(table, "friction_force")
+        friction = table.column("friction_force") * f_unit[1]
     else:
+        f_unit = n_unit
         unit = table.unit("friction_coefficient")
         if unit is not None:
             raise MetainterfaceError(
@@ -89,19 +105,32 @@ def read_friction_csv(path: str | os.PathLike[str], *, check: bool = True) -> Fr
         friction_force=friction,
         rows=np.arange(1, friction.size + 1),
         source=str(path),
+        normal_unit=n_unit,
+        friction_unit=f_unit,
     )
     if check:
         check_law(law)
     else:
-        check_values(law.source, "normal_force", law.normal_force)
-        check_values(law.source, "friction_force", law.friction_force)
+        check_values(law.source, "normal_force", law.normal_force, n_unit, negative=pull)
+        check_values(law.source, "friction_force", law.friction_force, f_unit)
     return law
 
 
-def check_values(source: Any, name: str, values: np.ndarray) -> None:
+def check_values(
+    source: Any,
+    name: str,
+    values: np.ndarray,
+    unit: tuple[str, float] | None = None,
+    *,
+    negative: bool = False,
+) -> None:
+    """A one-line error for the first value not finite or (unless ``negative``) below 0,
+    in the file's ``unit`` (label, N per unit) where it has one."""
     for i, v in enumerate(values, start=1):
-        if not math.isfinite(v) or v < 0:
-            raise MetainterfaceError(f"{source}: row {i}: {name} = {v:g}; must be finite and >= 0")
+        if not math.isfinite(v) or (v < 0 and not negative):
+            shown = f"{v:g}" if unit is None or not math.isfinite(v) else in_unit(v, unit)
+            need = "finite" if negative else "finite and >= 0"
+            raise MetainterfaceError(f"{source}: row {i}: {name} = {shown}; must be {need}")
 
 
 def zero_load_friction(law: FrictionLaw, k: int, why: str = "") -> str:

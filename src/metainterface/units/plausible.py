@@ -18,6 +18,10 @@ from metainterface.errors import UnitSlipWarning
 MODULUS_RANGE = (1e3, 1e12)
 #: A radius R [m] above this is a unit slip (an asperity is not larger than a hand).
 RADIUS_MAX = 0.1
+#: A work of adhesion w [J/m^2] outside this range is a unit slip (issue 52): van der Waals
+#: contacts of soft solids give 20-100 mJ/m^2, the strongest tapes about 1 J/m^2; a plain
+#: number is read as J/m^2, so '--work-of-adhesion 50' (meant: mJ/m^2) is 50 J/m^2.
+WORK_RANGE = (1e-4, 1.0)
 #: A modulus a slipped one is scaled towards (1000-fold steps): an elastomer's E*.
 _TYPICAL_MODULUS = 1e5
 
@@ -51,9 +55,11 @@ def unit_slips(
     modulus: float | None = None,
     shear_strength: float | None = None,
     radius: float | None = None,
+    work_of_adhesion: float | None = None,
 ) -> list[str]:
     """One line per implausible value (SI: modulus E* and shear strength tau in Pa, radius R
-    in m; None: not given), each with what was probably meant, e.g.
+    in m, work of adhesion w in J/m^2 (0: none); None: not given), each with what was
+    probably meant, e.g.
     ``'modulus 2.4 Pa is below 1 kPa: a unit slip? (2.4MPa)'``."""
     out = []
     low, high = MODULUS_RANGE
@@ -82,6 +88,19 @@ def unit_slips(
         out.append(
             f"radius {_shown(radius, 'm')} is above 10 cm: a unit slip? ({meant * 1e3:.4g}mm)"
         )
+    w_low, w_high = WORK_RANGE
+    if work_of_adhesion is not None and work_of_adhesion > w_high:
+        meant = _meant(work_of_adhesion, 1e-3, lambda v: v <= w_high)
+        out.append(
+            f"work of adhesion {work_of_adhesion:.4g} J/m^2 is above 1 J/m^2 (a number "
+            f"without a unit is J/m^2): a unit slip? ({meant * 1e3:.4g}mJ/m2)"
+        )
+    elif work_of_adhesion is not None and 0 < work_of_adhesion < w_low:
+        meant = _meant(work_of_adhesion, 1e3, lambda v: v >= w_low)
+        out.append(
+            f"work of adhesion {work_of_adhesion * 1e3:.4g} mJ/m^2 is below 0.1 mJ/m^2: a unit "
+            f"slip? ({meant * 1e3:.4g}mJ/m2)"
+        )
     return out
 
 
@@ -103,8 +122,14 @@ def warn_unit_slips(
     modulus: float | None = None,
     shear_strength: float | None = None,
     radius: float | None = None,
+    work_of_adhesion: float | None = None,
 ) -> None:
     """Warn (:class:`UnitSlipWarning`, one per slip) about values :func:`unit_slips` finds
     implausible, at the user's call. SI values as :func:`unit_slips`."""
-    for message in unit_slips(modulus=modulus, shear_strength=shear_strength, radius=radius):
+    for message in unit_slips(
+        modulus=modulus,
+        shear_strength=shear_strength,
+        radius=radius,
+        work_of_adhesion=work_of_adhesion,
+    ):
         warnings.warn(message, UnitSlipWarning, stacklevel=_user_level())

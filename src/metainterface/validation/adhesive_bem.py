@@ -250,6 +250,9 @@ def solve_jkr(
 
     contact, pressure: the previous state of a path (hysteresis: a point that touched stays
     bonded until its tension exceeds sigma_c), or None: start from the rigid overlap.
+    Raises MetainterfaceError where a bonded solve does not reach ``tolerance`` in
+    ``max_iter`` iterations (not a contact state), or the contact set does not settle in
+    ``max_updates`` updates.
     """
     b, m, _ = heights.shape
     fwd = forward_kernel(m, side, heights.device)
@@ -266,6 +269,13 @@ def solve_jkr(
     came_off = torch.zeros_like(contact)
     for _ in range(max_updates):
         p, res = _bonded(z, c, contact, fwd, p, tolerance, max_iter)
+        if not bool((res <= tolerance).all()):
+            # a bonded solve stopped short is not a contact state: its pressures, and the
+            # points it lets come off, are the iteration's, not the contact's
+            raise MetainterfaceError(
+                f"adhesive BEM (JKR) did not converge: conjugate-gradient residual "
+                f"{float(res.max()):.3g} > tolerance {tolerance:g} after {max_iter} iterations"
+            )
         g = displacement(p, fwd) - z - c
         beside = _neighbours(contact) & ~contact
         attach = ~contact & ((g < 0) | (beside & ~came_off & (g < g_close)))
@@ -352,7 +362,10 @@ class AdhesivePath:
     (K,) bool, the loading samples a rising force reaches (force at its running maximum
     and > 0: the states of the load-controlled curve the forward model gives, as far as the
     samples tell: a peak between two samples is not seen); touching: (K, N) bool, which
-    asperities have a point in contact (with ``owner``, else None).
+    asperities have a point in contact (with ``owner``, else None); asperity_alpha: (K, N)
+    each asperity's contact area over the cell's (with ``owner``); p_max: (K,) the largest
+    local pressure [E*]; residual: (K,) the bonded solve's relative residual; seconds: (K,)
+    wall time of each state; pressure: (M, M) the last state's pressure [E*].
     """
 
     approach: np.ndarray
@@ -361,6 +374,11 @@ class AdhesivePath:
     loading: np.ndarray
     on_branch: np.ndarray
     touching: np.ndarray | None = None
+    asperity_alpha: np.ndarray | None = None
+    p_max: np.ndarray | None = None
+    residual: np.ndarray | None = None
+    seconds: np.ndarray | None = None
+    pressure: np.ndarray | None = None
 
 
 def jkr_path(
@@ -381,19 +399,26 @@ def jkr_path(
     z_bar = -float(z.mean())
     up = np.asarray(approaches, dtype=np.float64)
     down = np.zeros(0) if unload is None else np.asarray(unload, dtype=np.float64)
+    import time
+
     contact = pressure = None
-    p_star, alpha, touching = [], [], []
+    p_star, alpha, touching, share, p_max, residual, seconds = [], [], [], [], [], [], []
     n_owner = 0 if owner is None else int(owner.max()) + 1
     own = None if owner is None else torch.as_tensor(owner, device=z.device).reshape(-1)
     for d in np.concatenate([up, down]):
+        start = time.perf_counter()
         target = torch.tensor([z_bar - d], dtype=torch.float64, device=z.device)
         sol = solve_jkr(z, side, target, work, contact=contact, pressure=pressure)
         contact, pressure = sol.contact, sol.pressure
         p_star.append(float(sol.p_star[0]))
         alpha.append(float(sol.alpha[0]))
+        p_max.append(float(sol.pressure[0].amax()))
+        residual.append(float(sol.residual[0]))
         if own is not None:
             hits = torch.bincount(own[sol.contact[0].reshape(-1)], minlength=n_owner)
             touching.append((hits > 0).cpu().numpy())
+            share.append((hits / own.numel()).cpu().numpy())
+        seconds.append(time.perf_counter() - start)
     p = np.array(p_star)
     loading = np.arange(p.size) < up.size
     top = np.maximum.accumulate(np.where(loading, p, -np.inf))
@@ -405,4 +430,9 @@ def jkr_path(
         loading,
         on_branch,
         np.array(touching) if own is not None else None,
+        np.array(share) if own is not None else None,
+        np.array(p_max),
+        np.array(residual),
+        np.array(seconds),
+        None if pressure is None else pressure[0].cpu().numpy(),
     )

@@ -307,9 +307,9 @@ def plan_validation(
         # this BEM has no adhesion: against an adhesive model every load would read the
         # adhesion's own effect (tens of per cent at low load) as the model's error
         raise MetainterfaceError(
-            f"model {model.label} has adhesion, which this BEM leaves out: an adhesive "
-            "design is checked in the adhesive (JKR-limit) BEM by design's check "
-            "(mi.design(..., verify=mi.Verify()), or the design command); here compare "
+            f"model {model.label} has adhesion, which this BEM leaves out: one adhesive "
+            "design is validated in the adhesive (JKR-limit) BEM by mi.validate (or the "
+            "validate command with one design) and checked by design's check; here compare "
             "the adhesionless model, e.g. model='independent'",
             argument="model",
         )

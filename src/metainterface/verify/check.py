@@ -320,18 +320,20 @@ def _adhesive_check(
 ) -> BemCheck:
     """``bem_check`` of a design made with an adhesive model: the JKR-limit BEM under a
     rising force, at the states its path reaches (``verify.adhesive``)."""
-    from metainterface.verify.adhesive import solve_adhesive
+    from metainterface.verify.adhesive import bounded_check
 
-    grid = settings.grid_for(design.settings)
-    solved = solve_adhesive(
+    settings.grid_for(design.settings)  # a grid given is checked against the cell
+    bounded = bounded_check(
         design,
         target,
         model,
-        grid=grid,
+        grid=settings.grid,
         loads=settings.loads,
+        max_error=settings.max_error,
         device=settings.device,
         engine=settings.engine,
     )
+    solved, grid = bounded.solved, bounded.grid
     alpha_t = np.interp(solved.p_star, target.p_star, target.alpha)
     return BemCheck(
         p_star=solved.p_star,
@@ -343,8 +345,10 @@ def _adhesive_check(
         grid=grid,
         engine="torch",
         device=solved.device,
-        seconds=solved.seconds,
+        seconds=bounded.seconds,
         max_error=settings.max_error,
         notes=solved.notes,
         adhesion=float(model.adhesion),
+        accuracy=bounded.accuracy,
+        coarse_grid=bounded.grids[-2],
     )
