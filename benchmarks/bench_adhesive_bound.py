@@ -25,6 +25,8 @@ from metainterface._testing import adhesive_cell_curve
 from metainterface.verify.check import bem_check
 
 E, R, W_J = 2.4e6, 0.5e-3, 0.05
+# Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
+QUICK = "--grid 96"
 
 
 def main() -> None:

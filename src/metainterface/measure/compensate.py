@@ -29,7 +29,6 @@ import torch
 
 from metainterface.errors import MetainterfaceError
 from metainterface.measure.predict import (
-    ERROR_POINTS,
     bem_error,
     coarse_grid,
     curve_errors,
@@ -42,6 +41,7 @@ from metainterface.measure.register import Registration
 from metainterface.measure.shapes import Shapes, Terraces, on_levels
 from metainterface.measure.surface import asperity_index, lattice_surface
 from metainterface.physics.cell import Design
+from metainterface.physics.grid_error import error_grid
 from metainterface.physics.registry import get_model
 
 #: Steps of the refinement with the map inside.
@@ -383,9 +383,8 @@ def _limits(
 def _refine(g0, h0, pmap, design, target, model, steps):
     """Adam on the printed geometry, the map inside, projected onto the bounds."""
     s = design.settings
-    p_t, a_t = target
-    grid = torch.linspace(0.0, float(p_t[-1]), ERROR_POINTS, dtype=torch.float64)[None]
-    ref = torch.as_tensor(np.interp(grid[0].numpy(), p_t, a_t, left=0.0))[None]
+    grid_np, ref_np = error_grid(target)
+    grid, ref = torch.as_tensor(grid_np)[None], torch.as_tensor(ref_np)[None]
     g = torch.tensor(g0, requires_grad=True)
     h = torch.tensor(h0 / s.delta_max, requires_grad=True)
     gb = torch.as_tensor(pmap.gamma_bias)

@@ -34,14 +34,13 @@ from metainterface.measure.scan import Scan
 from metainterface.measure.shapes import Shapes, analyse, restore
 from metainterface.measure.surface import lattice_surface
 from metainterface.physics.cell import Design
+from metainterface.physics.grid_error import grid_curve_error
 from metainterface.physics.metrics import curve_error
 from metainterface.physics.registry import get_model
 from metainterface.validation import owner_map, solve_path
 
 #: BEM grid points per scan pixel (``default_grid``).
 GRID_PER_PIXEL = 2.0
-#: Points of the uniform grid the fitted model's curve errors are measured on.
-ERROR_POINTS = 128
 #: Where BEM and fitted model differ by more than this, the fitted family misses a shape.
 DISAGREE = 0.03
 #: A contact narrower (in diameter) than this many scan pixels is not resolved by the scan.
@@ -168,14 +167,9 @@ def curve_errors(
     model: Any = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(error (B,), coverage (B,)) of the cells (gamma, h) (B, N) by the forward model
-    against ``target``, on its ERROR_POINTS grid (the fitted family's errors)."""
-    p_t, a_t = target
-    grid = np.linspace(0.0, float(p_t[-1]), ERROR_POINTS)
-    ref = np.interp(grid, p_t, a_t, left=0.0)
-    alpha, p_max = model_alpha(gamma, h, design, grid, model)
-    b = alpha.shape[0]
-    err = curve_error(alpha, np.tile(ref, (b, 1)), np.tile(grid, (b, 1)), p_max)
-    return np.asarray(err), np.minimum(1.0, p_max / p_t[-1])
+    against ``target``: the package's one grid curve error
+    (``physics.grid_error.grid_curve_error``) on this design's cell."""
+    return grid_curve_error(gamma, h, design.settings, target, model)
 
 
 def bem_error(p_star: np.ndarray, alpha: np.ndarray, target: tuple[np.ndarray, np.ndarray]):
