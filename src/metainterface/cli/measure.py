@@ -60,6 +60,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(default: read from the scan where it shows terraces)",
     )
     p.add_argument(
+        "--work-of-adhesion",
+        help="an adhesive part's work of adhesion, e.g. 50mJ/m2 (with --modulus): the "
+        "measured cell solved in the JKR-limit BEM against the design's adhesive target",
+    )
+    p.add_argument(
         "--max-error",
         default="5%",
         help="exit status 3 when the made error (BEM) is above this (default 5%%)",
@@ -105,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
         compensate=args.compensate,
         device=args.device,
         z_step=args.z_step,
+        work_of_adhesion=args.work_of_adhesion,
         also=[tuple(pair) for pair in args.also],
     )
     print(result.report(max_error))

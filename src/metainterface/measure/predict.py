@@ -248,6 +248,7 @@ class Prediction:
     share: np.ndarray
     error_alone: np.ndarray
     target: tuple[np.ndarray, np.ndarray]
+    adhesion: float = 0.0
 
 
 def solve_cell(
@@ -287,6 +288,7 @@ def predict(
     engine: Any = None,
     device: Any = "auto",
     z_step: float | None = None,
+    adhesion: float = 0.0,
 ) -> Prediction:
     """BEM of the measured cell (and of it on a grid half as fine), the fitted model beside
     it, against the design's target (module docstring).
@@ -294,8 +296,13 @@ def predict(
     grid: M of the measured cell (default ``default_grid``); loads: K BEM loads, uniform up
     to the target's largest; model: the forward model; report: called with 1 after each
     load of either grid; engine, device: the BEM's (``solve_path``); z_step: the printer's
-    layer step [R] where known (else read from the scan)."""
+    layer step [R] where known (else read from the scan). adhesion: the work of adhesion
+    [E* R] of an adhesive part: the cell is then solved in the JKR-limit BEM by approach,
+    its loading curve the states a rising force reaches (``adhesive_bem.jkr_path``), and
+    the fitted model is the adhesive one."""
     s = design.settings
+    if adhesion > 0:
+        model = get_model(model).with_adhesion(adhesion)
     target = target_of(design, model)
     grid = default_grid(scan, design) if grid is None else grid
     grid2 = coarse_grid(grid, s.n_side)
@@ -305,9 +312,17 @@ def predict(
     raw2 = measured_cell(scan, reg, design, grid2)
     cell2 = restore(raw2.heights, owner_map(s.n_side, grid2), shapes)
     p = loads_over(target, loads)
-    path = solve_cell(cell, design, p, engine=engine, device=device, report=report)
-    path2 = solve_cell(cell2, design, p, engine=engine, device=device, report=report)
-    errs_bem = bem_error(p, np.stack([path.alpha, path2.alpha]), target)
+    if adhesion > 0:
+        depth = _approach_depth(reg, design, model, float(p[-1]))
+        alpha1 = adhesive_alpha(cell, design, p, adhesion, depth, device=device, report=report)
+        alpha2 = adhesive_alpha(cell2, design, p, adhesion, depth, device=device, report=report)
+        resolved = None  # the adhesive path keeps no per-asperity areas
+    else:
+        path = solve_cell(cell, design, p, engine=engine, device=device, report=report)
+        path2 = solve_cell(cell2, design, p, engine=engine, device=device, report=report)
+        alpha1, alpha2 = path.alpha, path2.alpha
+        resolved = resolved_from(p, path.asperity_alpha, s.cell_side, max(scan.dx, scan.dy))
+    errs_bem = bem_error(p, np.stack([alpha1, alpha2]), target)
     h_design = design.h - design.h.min()
     both, _ = model_alpha(
         np.stack([reg.gamma, design.gamma]), np.stack([reg.h, h_design]), design, p, model
@@ -325,11 +340,11 @@ def predict(
     excess = np.maximum(alone - errs[1], 0.0)
     share = excess / excess.sum() if excess.sum() > 0 else np.zeros(n)
     with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(alpha_fit > 0, path.alpha / alpha_fit, np.inf)
+        ratio = np.where(alpha_fit > 0, alpha1 / alpha_fit, np.inf)
     return Prediction(
         p_star=p,
-        alpha_bem=path.alpha,
-        alpha_coarse=path2.alpha,
+        alpha_bem=alpha1,
+        alpha_coarse=alpha2,
         alpha_target=np.interp(p, target[0], target[1], left=0.0),
         alpha_fit=alpha_fit,
         alpha_design=alpha_design,
@@ -340,7 +355,8 @@ def predict(
         coverage_fit=float(cover[0]),
         grid=grid,
         grid_coarse=grid2,
-        resolved_from=resolved_from(p, path.asperity_alpha, s.cell_side, max(scan.dx, scan.dy)),
+        resolved_from=resolved,
+        adhesion=adhesion,
         disagree=np.abs(ratio - 1.0) > DISAGREE,
         cell=MeasuredCell(
             heights=cell,
@@ -354,3 +370,61 @@ def predict(
         error_alone=alone,
         target=target,
     )
+
+
+#: Approaches of the adhesive path per load asked for (states off the rising branch, just
+#: after a snap-in, are dropped).
+APPROACHES_PER_LOAD = 3
+
+
+def _approach_depth(reg: Registration, design: Design, model: Any, top: float) -> float:
+    """The approach [R] at which the fitted adhesive model's loading curve reaches ``top``,
+    and a quarter more (the BEM's cell may need it), at most 2 Delta_max."""
+    s = design.settings
+    g = torch.as_tensor(reg.gamma[None].astype(np.float64))
+    h = torch.as_tensor(reg.h[None].astype(np.float64))
+    with torch.no_grad():
+        sw = get_model(model).sweep(g, h, s)
+    delta = (sw.delta[0] if sw.delta.dim() == 2 else sw.delta).numpy()
+    reach = np.flatnonzero(sw.p_star[0].numpy() >= top)
+    end = float(delta[reach[0]]) if reach.size else float(delta[-1])
+    return min(2.0 * s.delta_max, 1.25 * end)
+
+
+def adhesive_alpha(
+    cell: np.ndarray,
+    design: Design,
+    p_star: np.ndarray,
+    adhesion: float,
+    depth: float,
+    *,
+    device: Any = "auto",
+    report: Callable[[int], Any] | None = None,
+) -> np.ndarray:
+    """alpha (K,) of an adhesive cell (M, M) [R] at loads p_star (K,) under a rising force:
+    the JKR-limit BEM by approach up to ``depth`` [R], the states on the rising-force branch,
+    read at the loads (held beyond them). adhesion: w [E* R]."""
+    from metainterface._device import resolve_device
+    from metainterface.validation.adhesive_bem import jkr_path
+
+    s = design.settings
+    k = APPROACHES_PER_LOAD * len(p_star)
+    approaches = depth * np.arange(1, k + 1) / k
+    path = jkr_path(
+        cell - cell.max(),
+        s.cell_side,
+        adhesion * s.e_star * s.radius,
+        approaches,
+        device=resolve_device(device),
+    )
+    if report is not None:
+        report(len(p_star))
+    keep = path.on_branch
+    if keep.sum() < 2:
+        from metainterface.errors import MetainterfaceError
+
+        raise MetainterfaceError(
+            "the adhesive BEM of the measured cell reached too few loads under a rising force"
+        )
+    order = np.argsort(path.p_star[keep])
+    return np.interp(p_star, path.p_star[keep][order], path.alpha[keep][order])

@@ -148,7 +148,12 @@ class MeasureResult:
                 f"scan noise {sh.noise * um:.2g} um: the cell smoothed by a Gaussian of "
                 f"{sh.smoothed:.2g} grid steps"
             )
-        if p.resolved_from is None:
+        if p.adhesion > 0:
+            out.append(
+                "adhesive part: the cell solved in the JKR-limit BEM by approach (its "
+                "contacts' resolution by the scan is not estimated)"
+            )
+        elif p.resolved_from is None:
             out.append("the scan's pixels resolve the contacts at none of the loads")
         elif p.resolved_from > p.p_star[0]:
             out.append(

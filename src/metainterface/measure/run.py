@@ -37,6 +37,7 @@ def measure(
     out: str | os.PathLike[str] | None = None,
     device: Any = "auto",
     z_step: Any = None,
+    work_of_adhesion: Any = None,
     also: Sequence[tuple[Any, Design | str | os.PathLike[str]]] = (),
 ) -> MeasureResult:
     """Measure a made part: read, level and register its scan, fit every asperity of every
@@ -55,11 +56,13 @@ def measure(
     design the next print (``MeasureResult.compensation``; the same as ``.compensate()``
     later), judged in BEM on its predicted made cell and kept only if it improves.
     z_step: the printer's layer step (e.g. "1um") where known (else read from the scan's
-    terraces). out: a folder to write measured.json, bem.csv, measured.png (and
-    compensated.json) in (``MeasureResult.write``). device: where the BEM runs ("auto",
-    "cpu", "cuda", "cuda:N"). also: more (scan, design) pairs of the same print (read as
-    ``scan`` is), registered only, whose made asperities and shapes join this one's in the
-    process that ``compensate`` models.
+    terraces). work_of_adhesion: an adhesive part's (e.g. "50mJ/m2", with ``modulus``):
+    its cell is solved in the JKR-limit BEM, against the design's adhesive target. out: a
+    folder to write measured.json, bem.csv, measured.png (and compensated.json) in
+    (``MeasureResult.write``). device: where the BEM runs ("auto", "cpu", "cuda",
+    "cuda:N"). also: more (scan, design) pairs of the same print (read as ``scan`` is),
+    registered only, whose made asperities and shapes join this one's in the process that
+    ``compensate`` models.
 
     Returns a :class:`MeasureResult` (``.registration``, ``.prediction``, ``.error``,
     ``.compensate()``, ``.write(folder)``). Raises MetainterfaceError in one line: unknown
@@ -78,8 +81,19 @@ def measure(
     if "size" in read and not isinstance(scan, str | os.PathLike):
         raise MetainterfaceError("size is for a scan file; an array takes pixel_size")
     s = as_scan(scan, radius=radius, pixel_size=pixel_size, **read)
-    friction = _friction(modulus, shear_strength, area)
+    # the modulus alone serves an adhesive part's work of adhesion
+    alone = work_of_adhesion is not None and shear_strength is None and area is None
+    friction = None if alone else _friction(modulus, shear_strength, area)
     z = None if z_step is None else _length(z_step, "z_step") / s.radius_m
+    adhesion = 0.0
+    if work_of_adhesion is not None:
+        from metainterface.units.quantities import parse_work_of_adhesion
+
+        if friction is None and modulus is None:
+            raise MetainterfaceError("work_of_adhesion needs the modulus (E*) too")
+        e_star = friction.modulus if friction is not None else _pressure(modulus)
+        w = parse_work_of_adhesion(work_of_adhesion, option="work_of_adhesion")
+        adhesion = w / (e_star * s.radius_m)
     if isinstance(loads, bool) or not isinstance(loads, int) or not 2 <= loads <= 200:
         raise MetainterfaceError(f"loads must be a whole number in [2, 200], got {loads!r}")
     if out is not None:
@@ -116,6 +130,7 @@ def measure(
             report=report,
             device=device,
             z_step=z,
+            adhesion=adhesion,
         )
     result = MeasureResult(
         scan=s, design=design, registration=reg, prediction=pred, friction=friction
@@ -156,6 +171,12 @@ def _length(value: Any, name: str) -> float:
     from metainterface.units import parse_length
 
     return parse_length(value, option=name)
+
+
+def _pressure(value: Any) -> float:
+    from metainterface.units import parse_pressure
+
+    return parse_pressure(value, option="modulus")
 
 
 def _friction(modulus: Any, shear_strength: Any, area: Any) -> Friction | None:
