@@ -124,8 +124,8 @@ class DesignResult(ReachCounts):
 
     @functools.cached_property
     def f0_error(self) -> float | None:
-        """An offset law's design: |F_0 / F_0,law - 1|, its friction at zero load against
-        the law's (under the model it was designed with); None for any other target."""
+        """An offset law's design: ``abs(F_0 / F_0,law - 1)``, its friction at zero load
+        against the law's (under the model it was designed with); None for any other target."""
         from metainterface.inverse.offset import f0_error
 
         d = self.design

@@ -120,8 +120,9 @@ class ValidationResult:
         alpha (K,), measured at this result's loads, against the design's target; or None
         without a target.
 
-        Measured as ``design`` measures, by :func:`~metainterface.physics.grid_error.
-        grid_curve_error`: on the target's uniform grid of ``ERROR_POINTS`` pressures, with
+        Measured as ``design`` measures, by
+        ``physics.grid_error.grid_curve_error``: on the target's uniform
+        grid of ``ERROR_POINTS`` pressures, with
         the model's exact alpha there times alpha / alpha_model interpolated between the
         loads (a ratio that is not finite counts as 1; so the model's own alpha scores
         exactly the model's design error, and the BEM's differs only by the measured ratio);
