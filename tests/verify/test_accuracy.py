@@ -14,7 +14,7 @@ from metainterface.cli import main
 from metainterface.verify import Verify, bem_check, correct
 from metainterface.verify.accuracy import ORDER, ORDER_RANGE, accuracy, coarse_grid, extrapolate
 from metainterface.verify.check import AUTO_CORRECT_MARGIN
-from metainterface.verify.correct import STOP_ERROR, stop_error
+from metainterface.verify.correct import STOP_ERROR, settled, stop_error
 
 # 192^2: the coarsest grid whose half (96^2, 32 points per asperity) is on the area's h^p
 # course; 4 loads keep each solve about a second
@@ -88,10 +88,15 @@ def test_the_accuracy_covers_a_grid_twice_as_fine(design, checked):
     assert abs(fine.bem_error - checked.bem_error) <= fine.accuracy + checked.accuracy
 
 
-def test_the_correction_stops_at_the_checks_accuracy(design, checked):
+def test_the_correction_stops_where_the_check_cannot_show_a_gain(design, checked):
     assert stop_error(replace(checked, accuracy=None)) == STOP_ERROR
     assert stop_error(replace(checked, accuracy=1e-4)) == STOP_ERROR
-    within = replace(checked, accuracy=1.5 * checked.bem_error)
+    # a step takes off at most the error less the accuracy (the check's floor): settled
+    # once that is within the accuracy, i.e. the error within twice it
+    e = checked.bem_error
+    assert settled(replace(checked, accuracy=0.55 * e))
+    assert not settled(replace(checked, accuracy=0.45 * e))
+    within = replace(checked, accuracy=0.55 * e)
     assert stop_error(within) == within.accuracy
     s = replace(QUICK, correct=True)
     out = correct(design.design, design.target, within, s, design.model)

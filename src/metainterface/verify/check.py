@@ -90,7 +90,8 @@ class Verify:
     correct : bool or None
         Correct the design in BEM (output space mapping, ``metainterface.verify.correct``);
         None (default): only where the BEM error exceeds the model's own error at the same
-        loads by more than 0.5 points (``AUTO_CORRECT_MARGIN``).
+        loads by more than 0.2 points or the check's accuracy (``AUTO_CORRECT_MARGIN``), and
+        only until the BEM error is within that model error (or the check's accuracy).
     iterations : int
         Most BEM solves the correction may spend, in [1, 20].
     inner : str or None
@@ -101,8 +102,9 @@ class Verify:
     restart : bool
         Each correction iteration also designs afresh against the shifted target (the
         surrogate and its hedge starts, on the correction's model) and keeps whichever
-        design meets it better in that model (default True; no extra BEM solve); the first
-        skips it where the re-refined design meets the shifted target within 0.1 %. Not for
+        design meets it better in that model (default True; no extra BEM solve); it is
+        skipped where the re-refined design meets the shifted target within 0.1 % and the
+        previous iteration (if any) was kept. Not for
         the Hertz baseline or heights fixed on a printer's layers.
     max_error : float
         The BEM error a design is trusted within (0.02 = 2 %), in (0, 1]; above it the result

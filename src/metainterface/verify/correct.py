@@ -13,10 +13,12 @@ BEM's own answer (output space mapping, Bandler et al., IEEE Trans. Microw. Theo
 defect correction, Stetter, Numer. Math. 29 (1978) 425). Each iteration re-refines from the
 current design with the refinement's polish, then solves the new design in BEM; it is kept
 only if its BEM error fell, otherwise the step s is halved (1, 1/2, 1/4, ...) from the same
-design. The loop stops once the BEM error is within the check's own accuracy (at least
-``STOP_ERROR``), once a kept step lowered it by no more than that accuracy (a further step
-would move it within what the check resolves), or once ``Verify.iterations`` BEM solves are
-spent. Each check solves the
+design. The loop stops once the BEM error is within twice the check's own accuracy (at
+least ``STOP_ERROR``): the check reads no error below that accuracy, so the most a further
+step could show is the error less the accuracy, itself within what the check resolves (the
+README's main job: 0.57 % -> 0.25 % +- 0.13 % in one iteration, where a second took off
+0.005 points in 9 s); once a kept step lowered it by no more than that accuracy; or once
+``Verify.iterations`` BEM solves are spent. Each check solves the
 design at the check's loads k / K; the result's own error is read afterwards at the
 interleaved loads, which no iteration fitted (``designer.verified``).
 
@@ -36,8 +38,9 @@ correction's model) and keeps whichever of the two meets the shifted target bett
 model: no extra BEM solve. The fresh design costs several re-refinements (nine starts on
 the interacting model), so the first iteration makes it only where the re-refined design
 misses the shifted target by more than ``FRESH_GATE`` (within it the candidate already
-meets its target about as closely as the correction resolves, ``STOP_ERROR``); once the BEM
-has said that one iteration was not enough, every later one makes it too.
+meets its target about as closely as the correction resolves, ``STOP_ERROR``), or where the
+BEM refused the previous iteration's candidate (a stall, which the fresh start is for).
+
 """
 
 from __future__ import annotations
@@ -219,9 +222,16 @@ def with_adhesion(inner: ForwardModel, model: ForwardModel) -> ForwardModel:
 
 
 def stop_error(check: BemCheck) -> float:
-    """The BEM error the correction stops at: the check's own accuracy, at least
-    ``STOP_ERROR``."""
+    """What the check resolves: its own accuracy, at least ``STOP_ERROR``. The correction
+    stops once its BEM error is within twice that (``settled``) or a kept step gained no
+    more than that."""
     return max(STOP_ERROR, check.accuracy or 0.0)
+
+
+def settled(check: BemCheck) -> bool:
+    """Whether a further correction step cannot show a gain: the most it could take off is
+    the BEM error less the check's accuracy (its floor), and that is within the accuracy."""
+    return check.bem_error - stop_error(check) <= stop_error(check)
 
 
 def correct(
@@ -256,7 +266,7 @@ def correct(
     step = 1.0
     done: list[Correction] = []
     for i in range(settings.iterations):
-        if best_check.bem_error <= stop_error(best_check):
+        if settled(best_check):
             break
         t0 = time.perf_counter()
         curve = shifted_target(target, best_check, step, best_inner)
@@ -265,7 +275,7 @@ def correct(
         if settings.restart and param is FULL:
             fit = curve_fit_error(candidate, curve, inner)
             fresh = None
-            if fit > FRESH_GATE or done:
+            if fit > FRESH_GATE or (done and not done[-1].accepted):
                 fresh = fresh_design(curve, best.settings, inner, extra_loss, refine_settings, i)
             if fresh is not None and curve_fit_error(fresh, curve, inner) < fit:
                 candidate, start = fresh, "fresh"
