@@ -117,58 +117,43 @@ def test_one_answer_on_reach_with_adhesion(law_csv):
     assert m_hi > E
 
 
-def test_design_scale_designs_an_offset_law_with_its_area(law_csv, monkeypatch):
-    """The area chosen with the cell for the offset law (its true area 4 cm^2): in the
-    feasible range, the design adhesive (w / (E* R) at the chosen scale) and close. No
-    hedges: they are tested elsewhere, and were a quarter of this search's JKR sweeps."""
+def test_design_cli_area_auto_designs_an_offset_law_with_its_area(
+    law_csv, tmp_path, capsys, monkeypatch
+):
+    """The user's call: --area auto with --work-of-adhesion chooses the area with the cell
+    (the law's true area is 4 cm^2): in the feasible range, the design adhesive (w / (E* R)
+    at the chosen scale) and close; the chosen area the best of the finalists, scored with
+    F_0's error (issue 52). A fixed area out of reach is answered with the adhesive scale
+    advice. No hedges: they are tested elsewhere, and were a quarter of the search's JKR
+    sweeps."""
     # quick scores within 100 % of the best tie here, so that the finalists are designed
     # whatever this law's quick round reads (within TIE = 10 % it may or may not)
     monkeypatch.setattr("metainterface.scaling.choose.TIE", 1.0)
-    r = mi.design_scale(
-        law_csv,
-        area="2cm2..20cm2",
-        work_of_adhesion="50mJ/m2",
-        fit="never",
-        verify=False,
-        effort=mi.Effort(hedge=0, fallback=0),
-        **UNITS,
-    )
-    sc = r.target.meta["scale"]
-    assert sc["variable"] == "area" and 2e-4 <= sc["value"] <= 20e-4
-    assert r.model.adhesion == pytest.approx(W)
-    assert r.target.meta["friction"]["work_of_adhesion_j_m2"] == pytest.approx(W_J)
-    assert any(lo <= sc["value"] <= hi for lo, hi in sc["feasibility"]["ranges"]["area"])
-    assert r.error < 0.05
-    assert mi.reachability(r.target).reachable
-    # quick scores that tie are settled by full designs: the chosen one is the best of them,
-    # its score the curve error plus the uncovered share plus F_0's error (issue 52)
-    from metainterface.scaling.candidates import score, uncovered
-
-    finalists, scores = sc["finalists"], sc["finalist_scores"]
-    assert len(finalists) == 2 and sc["value"] in finalists
-    assert score(r) == pytest.approx(min(scores), rel=1e-9)
-    assert r.f0_error is not None
-    assert score(r) == pytest.approx(r.error + uncovered(r) + r.f0_error, rel=1e-12)
-
-
-def test_design_cli_area_auto_with_work_of_adhesion(law_csv, tmp_path, capsys):
-    """The user's call: --area auto with --work-of-adhesion designs the scale and the cell
-    with adhesive asperities; a fixed area out of reach is answered with the adhesive
-    scale advice."""
     base = ["design", "--friction-csv", str(law_csv), "--shear-strength", "0.3MPa"]
     base += ["--modulus", "2.4MPa", "--radius", "0.5mm", "--work-of-adhesion", "50mJ/m2"]
-    base += ["--fit", "never", "--refine", "none", "--hedge", "0", "--fallback", "0"]
-    base += ["--no-verify"]
+    base += ["--fit", "never", "--hedge", "0", "--fallback", "0", "--no-verify"]
     out = tmp_path / "auto"
     assert main([*base, "--area", "auto", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     assert "chose area =" in text
     data = json.loads((out / "design.json").read_text())
-    assert data["target"]["scale"]["variable"] == "area"
-    assert data["target"]["friction"]["work_of_adhesion_j_m2"] == pytest.approx(W_J)
-    assert "adhesion=" in data["model"]
+    sc, friction = data["target"]["scale"], data["target"]["friction"]
+    assert sc["variable"] == "area" and 2e-4 <= sc["value"] <= 20e-4
+    assert any(lo <= sc["value"] <= hi for lo, hi in sc["feasibility"]["ranges"]["area"])
+    assert friction["work_of_adhesion_j_m2"] == pytest.approx(W_J)
+    assert friction["adhesion"] == pytest.approx(W)
+    assert data["model"] == f"independent(adhesion={W:.10e})"
+    assert data["relative_error"] < 0.05
+    # quick scores that tie are settled by full designs: the chosen one is the best of them,
+    # its score the curve error plus the uncovered share plus F_0's error
+    finalists, scores = sc["finalists"], sc["finalist_scores"]
+    assert len(finalists) == 2 and sc["value"] in finalists
+    assert data["f0_error"] is not None
+    mine = data["relative_error"] + (1 - data["coverage"]) + abs(data["f0_error"])
+    assert mine == pytest.approx(min(scores), rel=1e-9)
+    assert scores[finalists.index(sc["value"])] == min(scores)
     fixed = tmp_path / "fixed"
-    assert main([*base, "--area", "1cm2", "--out", str(fixed)]) == 2
+    assert main([*base, "--refine", "none", "--area", "1cm2", "--out", str(fixed)]) == 2
     said = capsys.readouterr()
     assert "not reachable at area 1 cm^2" in said.out and "w = 50 mJ/m^2" in said.out
     assert "reachable with an area of" in said.out
