@@ -145,9 +145,14 @@ def test_offset_law_designed_within_two_percent(tmp_path):
         result = mi.design(target, verify=checks, effort=mi.Effort(seed=0))
     assert result.model.adhesion == pytest.approx(W)
     assert result.error < 0.02
-    # checked in the adhesive BEM (a coarse grid here: a / dx ~ 5-10, see bench_adhesion)
-    assert result.bem is not None and result.bem.adhesion == pytest.approx(W)
-    assert result.bem.p_star.size >= 2 and np.isfinite(result.bem.bem_error)
+    # checked in the adhesive BEM (a coarse grid here: a / dx ~ 5-10, see bench_adhesion),
+    # which bounds its own error from 96^2 and 48^2: the BEM meets the target as the model
+    # does, within that bound (a bound the JKR sphere holds, tests/verify/test_adhesive_bound)
+    bem = result.bem
+    assert bem is not None and bem.adhesion == pytest.approx(W)
+    assert bem.p_star.size >= 2 and bem.grid == 96 and bem.coarse_grid == 48
+    assert 0 < bem.accuracy < 0.2
+    assert bem.bem_error <= bem.model_error + bem.accuracy
     # the offset F_0, one point of the curve error, is stated on its own: the law's is the
     # CSV's zero-load row; the last polish that weighs it (inverse.offset) brought it from
     # +74 % to within 1 % (benchmarks/results/adhesion.md)
