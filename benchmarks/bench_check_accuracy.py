@@ -152,7 +152,7 @@ QUICK = "--quick --count 1"
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("--count", type=int, default=4, help="targets (4)")
+    ap.add_argument("--count", type=int, default=None, help="targets (4; --quick: 2)")
     ap.add_argument("--seed", type=int, default=HELD_BACK_SEED, help="held-back cells' seed")
     ap.add_argument("--loads", type=int, default=10, help="loads of the check (10)")
     ap.add_argument("--convergence", action="store_true", help="measure the grids' order")
@@ -163,7 +163,8 @@ def main() -> None:
     ap.add_argument("--out", help="write the markdown here")
     args = ap.parse_args()
     if args.quick:
-        args.count, args.loads = 2, 4
+        args.loads = 4
+    args.count = args.count or (2 if args.quick else 4)
     command = "python benchmarks/bench_check_accuracy.py " + " ".join(sys.argv[1:])
     text = convergence(args) if args.convergence else held_back(args)
     md = "\n".join(

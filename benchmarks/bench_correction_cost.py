@@ -4,7 +4,9 @@ seed=11)``), one after another; prints the CPU seconds of this process and its B
 and each target's BEM error. Compare two source trees by running it on each in turn
 (``PYTHONPATH=<tree>/src``), alternately.
 
-    PYTHONPATH=src python benchmarks/bench_correction_cost.py [--targets 5]
+    PYTHONPATH=src python benchmarks/bench_correction_cost.py [--targets 5] [--grid 384]
+
+``--grid``: the check's grid (default: the check's own, 384^2 for N = 9).
 """
 
 from __future__ import annotations
@@ -29,18 +31,20 @@ def cpu() -> float:
 
 
 # Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
-QUICK = "--targets 1"
+QUICK = "--targets 1 --grid 96"
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--targets", type=int, default=5)
+    ap.add_argument("--grid", type=int, default=None, help="the check's grid")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
-    mi.design("saturating")  # warm-up: the networks, the envelope, the BEM's workers
+    verify = mi.Verify(grid=args.grid)
+    mi.design("saturating", verify=verify)  # warm-up: the networks, the envelope, the workers
     targets = realisable_targets(args.targets, seed=11)
     c0, w0 = cpu(), time.perf_counter()
-    errors = [f"{100 * mi.design(t).bem.bem_error:.2f}" for t in targets]
+    errors = [f"{100 * mi.design(t, verify=verify).bem.bem_error:.2f}" for t in targets]
     print(
         f"{mi.__file__}: CPU {cpu() - c0:.1f} s, wall {time.perf_counter() - w0:.1f} s; "
         f"BEM errors %: {' '.join(errors)}"
