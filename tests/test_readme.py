@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -16,8 +18,11 @@ def test_ci_runs_the_readme_test_command():
     assert "pytest" in test_cmd
     ci = (ROOT / ".ci" / "run").read_text()
     assert test_cmd in ci
-    # the docs build (marked docs, out of the default run) is CI's step after it
-    assert "python -m pytest -q -m docs" in ci.split(test_cmd, 1)[1]
+    # the long runs and the docs build (marked long and docs, out of the default run) are
+    # CI's steps after it
+    after = ci.split(test_cmd, 1)[1]
+    assert "python -m pytest -q -m long\n" in after
+    assert "python -m pytest -q -m docs" in after
 
 
 def test_readme_install_takes_the_cpu_constraints():
@@ -25,6 +30,7 @@ def test_readme_install_takes_the_cpu_constraints():
         assert "-c constraints-cpu.txt" in cmd
 
 
+@pytest.mark.long
 def test_the_readme_python_example_runs_as_written(tmp_path, monkeypatch):
     text = (ROOT / "README.md").read_text()
     code = text.split("```python\n")[1].split("\n```")[0]

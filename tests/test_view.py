@@ -92,6 +92,7 @@ def _variance(png: bytes) -> float:
 
 
 @pytest.mark.skipif(CHROMIUM is None, reason="no chromium: apt-get install chromium")
+@pytest.mark.long
 def test_page_in_a_headless_browser(design_folder, tmp_path):
     sync_api = pytest.importorskip("playwright.sync_api", reason="the test extra's playwright")
     page_file = design_folder / "view.html"

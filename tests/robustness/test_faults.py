@@ -152,6 +152,7 @@ def _train_killed(dataset: Path, run: Path, rng: random.Random) -> None:
     assert not temporaries(run)
 
 
+@pytest.mark.long
 def test_train_killed_resumes_losing_at_most_the_epoch_in_progress(dataset, tmp_path):
     _train_killed(dataset, tmp_path / "run", random.Random(7))
 

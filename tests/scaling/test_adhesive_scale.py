@@ -117,6 +117,7 @@ def test_one_answer_on_reach_with_adhesion(law_csv):
     assert m_hi > E
 
 
+@pytest.mark.long
 def test_design_cli_area_auto_designs_an_offset_law_with_its_area(
     law_csv, tmp_path, capsys, monkeypatch
 ):

@@ -131,6 +131,7 @@ def test_adhesive_reach_holds_adhesive_cells():
     assert lo[0] > 0
 
 
+@pytest.mark.long
 def test_offset_law_designed_within_two_percent(tmp_path):
     """The issue's check: an offset law of a held-back adhesive cell (PDMS, 50 mJ/m^2)
     designed with the work of adhesion, within 2 %, and checked in the adhesive BEM."""

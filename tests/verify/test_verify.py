@@ -60,6 +60,7 @@ def test_the_check_reports_the_bem_error_to_the_target(checked, unchecked):
     assert "BEM error" in repr(checked) and "BEM" not in repr(unchecked)
 
 
+@pytest.mark.long
 def test_the_correction_lowers_the_bem_error(corrected):
     before, after = corrected.bem_before, corrected.bem
     assert before is not None and after.bem_error < before.bem_error
@@ -119,6 +120,7 @@ def test_the_shifted_target_takes_the_correction_models_alpha():
     np.testing.assert_allclose(a, [0.0, 0.095, 0.21, 0.31])
 
 
+@pytest.mark.long
 def test_the_correction_runs_on_the_model_asked_for(corrected):
     # corrected: the default, re-refined on the interacting model; "independent" and None
     # (the design's own model, here independent) re-refine on the paper's model alike
@@ -134,6 +136,7 @@ def test_the_correction_runs_on_the_model_asked_for(corrected):
     assert corrected.error == pytest.approx(on_design_model, rel=1e-9)
 
 
+@pytest.mark.long
 def test_each_iteration_says_where_its_design_came_from(corrected):
     # the default also designs afresh against the shifted target; restart=False only
     # re-refines the kept design
@@ -225,6 +228,7 @@ def test_design_json_and_figure_carry_the_check(checked, tmp_path):
     assert "BEM" in fig._suptitle.get_text()
 
 
+@pytest.mark.long
 def test_a_corrected_design_records_its_iterations(corrected, tmp_path):
     corrected.save(tmp_path)
     block = json.loads((tmp_path / "design.json").read_text())["bem_check"]
@@ -282,6 +286,7 @@ def test_cli_engine_option_names_itself(tmp_path, capsys):
     assert done.value.code == 2 and "--verify-engine" in capsys.readouterr().err
 
 
+@pytest.mark.long
 def test_cli_reports_each_correction_iteration(tmp_path, capsys):
     # corrected on the paper's model: the report is what is under test, and its fresh
     # designs cost two thirds of the interacting model's
