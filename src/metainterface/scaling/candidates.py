@@ -1,5 +1,5 @@
-"""The scale search's candidates: which values of the free scale variable to design, and
-how a candidate's design is scored (issue 53 asks design_scale split by what it does)."""
+"""The scale search's candidates: which values of the free scale variable to design, their
+quick designs and how each is scored, and the second round between the best."""
 
 from __future__ import annotations
 
@@ -87,3 +87,46 @@ def _closer(values: np.ndarray, errors: np.ndarray) -> np.ndarray:
 
 
 __all__ = ["_candidates", "_closer", "_coarse", "score", "uncovered"]
+
+
+def _quick_scores(
+    at: Any,
+    fs: _scale.FeasibleScale,
+    values: np.ndarray,
+    stem: str,
+    effort: Any,
+    options: dict[str, Any],
+) -> np.ndarray:
+    """(V,) each candidate value's score (``score``) from its quick design with ``effort``,
+    no BEM check (candidates are ranked on the model; the chosen one is checked); ``at``
+    makes the law's target at a value (``choose._AtScale``)."""
+    from metainterface.designer.run import design
+
+    targets = [at.target(v, f"{stem}-{i}") for i, v in enumerate(values)]
+    # one batch shares one model: candidate moduli with adhesion differ in w / (E* R)
+    batches = [[t] for t in targets] if _coarse(fs, at.var) else [targets]
+    made = [
+        r
+        for batch in batches
+        for r in design(batch, settings=at.settings, effort=effort, verify=False, **options)
+    ]
+    return np.array([score(r) for r in made])
+
+
+def _ranked(
+    fs: _scale.FeasibleScale,
+    var: str,
+    values: np.ndarray,
+    quick: Any,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The candidate values and their quick scores, with a second round between the best
+    and its neighbours (not on a coarse grid: its points are the values tested), sorted."""
+    errors = quick(values)
+    if values.size >= 3 and not _coarse(fs, var):
+        more = _closer(values, errors)
+        if more.size:
+            values = np.concatenate([values, more])
+            errors = np.concatenate([errors, quick(more)])
+            order = np.argsort(values)
+            values, errors = values[order], errors[order]
+    return values, errors

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -19,7 +19,7 @@ from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
 from metainterface.scaling import search as _scale
-from metainterface.scaling.candidates import _candidates, _closer, _coarse, score
+from metainterface.scaling.candidates import _candidates, _quick_scores, _ranked, score
 
 #: Candidate scales designed quickly before the chosen one is designed in full.
 CANDIDATES = 5
@@ -240,8 +240,7 @@ def design_scale(
     tiling it gives (cells and cells per side), the candidates and their scores and the
     feasibility summary, and design.json records them.
     """
-    from metainterface.designer.run import design
-    from metainterface.units.friction import FrictionLaw, friction_target
+    from metainterface.units.friction import FrictionLaw
 
     source = str(law) if not isinstance(law, FrictionLaw) else law.source
     in_scale = getattr(options.get("scale"), "work_of_adhesion", None)  # mi.Scale(...)
@@ -267,30 +266,8 @@ def design_scale(
     # with adhesion each modulus searched has an envelope of its own: only the free variable
     searched = (var,) if given["work_of_adhesion"] else _scale.VARIABLES
     given, fs = _feasible(law, given, var, span, s, searched)
-    values = _candidates(fs, var, candidates)
     stem = name or (os.path.splitext(os.path.basename(source))[0] or "friction")
-
-    def target(value: float, label: str) -> Target:
-        at = {**given, var: float(value)}
-        ft = friction_target(
-            law,
-            shear_strength=at["shear_strength"],
-            e_star=at["modulus"],
-            radius=at["radius"],
-            area=at["area"],
-            settings=settings,
-            fit="never",
-            work_of_adhesion=at["work_of_adhesion"],
-        )
-        record = ft.record()
-        if lf is not None:
-            from metainterface.units.friction import fit_record
-
-            record["fit"] = fit_record(lf)
-        return Target(
-            p_star=ft.p_star, alpha=ft.alpha, name=label, source=source, meta={"friction": record}
-        )
-
+    at = _AtScale(law, lf, given, var, source, settings)
     knobs, size, made_errors = option_groups(
         {k: options.pop(k) for k in list(options) if k in OLD_KEYWORDS},
         options.pop("effort", None),
@@ -298,71 +275,24 @@ def design_scale(
         options.get("robust"),
         "design_scale",
     )
-    effort = Effort(
-        hedge=knobs["hedge"],
-        seed=knobs["seed"],
-        surrogate=knobs["surrogate"],
-        fallback=0,
-        refine_settings=QUICK,
-        # a candidate's design is rarely within Effort.hedge_error: its hedges are refined
-        # with its prediction in one batch, not after it
-        hedge_error=0.0,
-    )
-    if given["work_of_adhesion"]:  # an offset law's F_0 is polished in the quick round too
-        effort = replace(effort, refine_settings=replace(QUICK, offset=True))
     quick_opts = {k: v for k, v in options.items() if k in ("method", "model")}
 
     def quick(vals: np.ndarray) -> np.ndarray:
-        targets = [target(v, f"{stem}-{i}") for i, v in enumerate(vals)]
-        # one batch shares one model: candidate moduli with adhesion differ in w / (E* R)
-        batches = [[t] for t in targets] if _coarse(fs, var) else [targets]
-        made = [
-            r
-            for batch in batches
-            for r in design(
-                batch,
-                settings=settings,
-                effort=effort,
-                verify=False,  # candidates are ranked on the model; the chosen one is checked
-                **quick_opts,
-            )
-        ]
-        return np.array([score(r) for r in made])
+        return _quick_scores(at, fs, vals, stem, _quick_effort(knobs, at.adhesive), quick_opts)
 
-    errors = quick(values)
-    # a second round between the best and its neighbours (not on a coarse grid: its points
-    # are the values tested)
-    if values.size >= 3 and not _coarse(fs, var):
-        more = _closer(values, errors)
-        if more.size:
-            values = np.concatenate([values, more])
-            errors = np.concatenate([errors, quick(more)])
-            order = np.argsort(values)
-            values, errors = values[order], errors[order]
+    values, errors = _ranked(fs, var, _candidates(fs, var, candidates), quick)
+
+    def full(value: float, extra: dict[str, Any], scores: dict[str, Any]) -> Any:
+        opts = {**options, **extra}
+        opts.update(
+            as_groups(knobs, at.size(size, value, fs), made_errors, opts.get("robust", False))
+        )
+        return _full_design(at, fs, value, stem, scores, opts)
+
     order = np.argsort(errors, kind="stable")
     tied = [int(i) for i in order[:FINALISTS] if errors[i] <= errors[order[0]] * (1 + TIE)]
     finals: dict[float, float] = {}
-
-    def full(value: float, extra: dict[str, Any], scores: dict[str, Any]) -> Any:
-        """The full design at ``value`` of the scale variable, with ``extra`` options."""
-        at = {**given, var: value}
-        n_cells, per_side = fs.tiles(at["area"])
-        t = target(value, stem)
-        record = {"variable": var, "value": value, "searched": list(fs.bounds[var])}
-        record.update(scores, n_cells=n_cells, tiles_per_side=per_side)
-        t = replace(t, meta={**t.meta, "scale": {**record, "feasibility": fs.record()}})
-        # the target carries the work of adhesion (w / (E* R) at the chosen scale)
-        at_size = {**size, "modulus": at["modulus"], "radius": at["radius"]}
-        at_size["work_of_adhesion"] = None
-        if at_size["total_force"] is None:
-            at_size["area"] = at["area"]
-        opts = {**options, **extra}
-        opts.update(as_groups(knobs, at_size, made_errors, options.get("robust", False)))
-        with warnings.catch_warnings():  # a unit slip was said once, above
-            warnings.simplefilter("ignore", UnitSlipWarning)
-            return design(t, settings=settings, **opts)
-
-    if len(tied) > 1 and given["work_of_adhesion"]:
+    if len(tied) > 1 and at.adhesive:
         for i in tied:
             r = full(float(values[i]), {"verify": False, "out": None}, {})
             finals[float(values[i])] = score(r)
@@ -375,6 +305,93 @@ def design_scale(
         scores["finalists"] = list(finals)
         scores["finalist_scores"] = list(finals.values())
     return full(chosen, {}, scores)
+
+
+@dataclass(frozen=True)
+class _AtScale:
+    """A law and its scale as given, the free variable ``var`` aside: the target and the
+    physical size at a value of it."""
+
+    law: Any
+    fitted: Any
+    given: dict
+    var: str
+    source: str
+    settings: CellSettings | None
+
+    @property
+    def adhesive(self) -> bool:
+        return bool(self.given["work_of_adhesion"])
+
+    def target(self, value: float, label: str) -> Target:
+        """The law as a target with ``var`` = ``value`` (the work of adhesion as w / (E* R)
+        at that scale, in its meta)."""
+        from metainterface.units.friction import fit_record, friction_target
+
+        at = {**self.given, self.var: float(value)}
+        ft = friction_target(
+            self.law,
+            shear_strength=at["shear_strength"],
+            e_star=at["modulus"],
+            radius=at["radius"],
+            area=at["area"],
+            settings=self.settings,
+            fit="never",
+            work_of_adhesion=at["work_of_adhesion"],
+        )
+        record = ft.record()
+        if self.fitted is not None:
+            record["fit"] = fit_record(self.fitted)
+        return Target(
+            p_star=ft.p_star, alpha=ft.alpha, name=label, source=self.source,
+            meta={"friction": record},
+        )  # fmt: skip
+
+    def size(self, size: dict[str, Any], value: float, fs: _scale.FeasibleScale) -> dict:
+        """The design's physical size options at ``value`` (the target carries w)."""
+        at = {**self.given, self.var: value}
+        out = {**size, "modulus": at["modulus"], "radius": at["radius"], "work_of_adhesion": None}
+        if out["total_force"] is None:
+            out["area"] = at["area"]
+        return out
+
+
+def _quick_effort(knobs: dict[str, Any], adhesive: bool) -> Effort:
+    """The candidates' quick design: a short refinement (``QUICK``), no fallback; an offset
+    law's F_0 polished in it too."""
+    effort = Effort(
+        hedge=knobs["hedge"],
+        seed=knobs["seed"],
+        surrogate=knobs["surrogate"],
+        fallback=0,
+        refine_settings=replace(QUICK, offset=True) if adhesive else QUICK,
+        # a candidate's design is rarely within Effort.hedge_error: its hedges are refined
+        # with its prediction in one batch, not after it
+        hedge_error=0.0,
+    )
+    return effort
+
+
+def _full_design(
+    at: _AtScale,
+    fs: _scale.FeasibleScale,
+    value: float,
+    stem: str,
+    scores: dict[str, Any],
+    options: dict[str, Any],
+) -> Any:
+    """The full design at ``value`` of the scale variable, its search recorded in the
+    target's meta ("scale")."""
+    from metainterface.designer.run import design
+
+    n_cells, per_side = fs.tiles({**at.given, at.var: value}["area"])
+    t = at.target(value, stem)
+    record = {"variable": at.var, "value": value, "searched": list(fs.bounds[at.var])}
+    record.update(scores, n_cells=n_cells, tiles_per_side=per_side)
+    t = replace(t, meta={**t.meta, "scale": {**record, "feasibility": fs.record()}})
+    with warnings.catch_warnings():  # a unit slip was said once, above
+        warnings.simplefilter("ignore", UnitSlipWarning)
+        return design(t, settings=at.settings, **options)
 
 
 def scale_line(result: Any) -> str | None:
