@@ -80,7 +80,7 @@ def measure(device: str, args: argparse.Namespace, work: Path) -> dict[str, str]
         progress=False,
         device=device,
     )
-    from metainterface.surrogate.train import read_metrics
+    from metainterface.surrogate.run_state import read_metrics
 
     per_epoch = read_metrics(run.run_dir)["seconds"]
     epoch = float(per_epoch.mean())

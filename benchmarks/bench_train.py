@@ -28,7 +28,8 @@ from metainterface.physics import CellSettings
 from metainterface.runtime import tune_allocator
 from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
-from metainterface.surrogate.train import read_metrics, train
+from metainterface.surrogate.run_state import read_metrics
+from metainterface.surrogate.train import train
 
 
 def _minor_faults() -> int:

@@ -26,8 +26,9 @@ from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.loss import param_loss, physics_loss
 from metainterface.surrogate.model import InverseMLP
+from metainterface.surrogate.run_state import read_metrics
 from metainterface.surrogate.schedules import Schedules
-from metainterface.surrogate.train import read_metrics, train
+from metainterface.surrogate.train import train
 
 S = mi.CellSettings()
 NO_CUDA = not torch.cuda.is_available()

@@ -15,8 +15,9 @@ from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.loss import LossWeights, weights_of
 from metainterface.surrogate.model import Dropout, InverseMLP, outputs_to_design
+from metainterface.surrogate.run_state import read_metrics
 from metainterface.surrogate.schedules import Schedules
-from metainterface.surrogate.train import read_metrics, train
+from metainterface.surrogate.train import train
 
 S = CellSettings()
 
@@ -134,10 +135,10 @@ def test_loss_falls_and_resume_is_bit_for_bit(tiny, tmp_path):
     half = TrainConfig(**{**cfg.__dict__})
     part = tmp_path / "part"
     # emulate a kill after epoch 2: train 2 epochs with the same config, then resume
-    from metainterface.surrogate import train as train_mod
+    from metainterface.surrogate import run_state
 
     calls = {"n": 0}
-    orig = train_mod.write_metrics
+    orig = run_state.write_metrics
 
     def killer(path, history):
         orig(path, history)
@@ -145,12 +146,12 @@ def test_loss_falls_and_resume_is_bit_for_bit(tiny, tmp_path):
         if calls["n"] == 2:
             raise KeyboardInterrupt
 
-    train_mod.write_metrics = killer
+    run_state.write_metrics = killer
     try:
         with pytest.raises(KeyboardInterrupt):
             train(tr, va, S, part, half, progress=False)
     finally:
-        train_mod.write_metrics = orig
+        run_state.write_metrics = orig
     train(tr, va, S, part, half, resume=True, progress=False)
     a = read_metrics(full.run_dir)
     b = read_metrics(part)

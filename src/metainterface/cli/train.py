@@ -159,7 +159,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.plot is not None:
         from metainterface.plots import plot_training, save_figure
-        from metainterface.surrogate.train import read_metrics
+        from metainterface.surrogate.run_state import read_metrics
 
         fig_path = args.figure if args.figure is not None else str(Path(args.plot) / "training.png")
         save_figure(plot_training(read_metrics(args.plot)), fig_path, command="train --plot")

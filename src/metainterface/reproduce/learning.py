@@ -22,7 +22,8 @@ from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import split_of
 from metainterface.surrogate.evaluate import Predictions, evaluate, predict_split
 from metainterface.surrogate.loss import weights_of
-from metainterface.surrogate.train import read_metrics, train
+from metainterface.surrogate.run_state import read_metrics
+from metainterface.surrogate.train import train
 
 # -- the dataset, fig. 3 and the wall case --------------------------------------------------
 

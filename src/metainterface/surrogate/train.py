@@ -23,19 +23,17 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import torch
 from tqdm.auto import tqdm
 
 from metainterface._device import resolve_device
 from metainterface._files import strict_json
 from metainterface._files.atomic import output_set, write_text
-from metainterface._files.columns import write_columns
 from metainterface._files.provenance import HASH_DIGITS, provenance
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.curves import curve
-from metainterface.surrogate.checkpoint import load_model, load_torch, save_model, save_torch
+from metainterface.surrogate.checkpoint import load_model, save_model
 from metainterface.surrogate.config import TrainConfig
 from metainterface.surrogate.data import Split
 from metainterface.surrogate.loss import (
@@ -47,9 +45,8 @@ from metainterface.surrogate.loss import (
     physics_loss,
 )
 from metainterface.surrogate.model import InverseMLP
-
-#: The columns of metrics.csv, one row an epoch.
-METRICS = ("epoch", "train_loss", "val_loss", "kappa", "lambda", "lr", "seconds")
+from metainterface.surrogate.run_state import RunState, save_epoch
+from metainterface.surrogate.run_state import resume as resume_run
 
 
 @dataclass(frozen=True)
@@ -168,7 +165,75 @@ def train(
     # the whole dataset on the device once: batches are then gathers there, no copies
     train_split, val_split = train_split.to(dev), val_split.to(dev)
     out = Path(out_dir)
-    ckpt_path = out / "checkpoint.pt"
+    model, opt, sched = _model_and_optimiser(settings, config, train_split, resume, dev)
+    state = RunState()
+    if resume:
+        state = resume_run(out / "checkpoint.pt", config, dataset_info, model, opt, sched, dev)
+    elif (out / "checkpoint.pt").exists():
+        raise MetainterfaceError(f"{out} already holds a run; use --resume or another --out")
+    run_info = {
+        "settings": settings.to_dict(),
+        "model": model.architecture(),
+        "train": asdict(config),
+        "dataset": dataset_info or {},
+        **({"init_sha256": _file_hash(config.init)} if config.init else {}),
+        "provenance": provenance(),
+    }
+    write_text(out / "config.json", strict_json.dumps(run_info, indent=2, default=str) + "\n")
+    t_run = time.perf_counter()
+    stopped = False
+    bar = tqdm(
+        range(state.epoch, config.epochs),
+        initial=state.epoch,
+        total=config.epochs,
+        unit="epoch",
+        disable=not progress,
+        desc="train",
+    )
+    for epoch in bar:
+        t0 = time.perf_counter()
+        kappa, lam = config.schedules.kappa(epoch), config.schedules.lam(epoch)
+        run_loss, batches = _train_epoch(model, opt, train_split, settings, config, epoch, dev)
+        lr = opt.param_groups[0]["lr"]
+        sched.step()
+        val = _validation_loss(model, val_split, settings, config, epoch)
+        row = {"epoch": epoch + 1, "train_loss": run_loss / batches, "val_loss": val}
+        row.update(kappa=kappa, **{"lambda": lam}, lr=lr, seconds=time.perf_counter() - t0)
+        state.history.append(row)
+        if not math.isfinite(run_loss):
+            raise MetainterfaceError(
+                f"training diverged at epoch {epoch + 1} (training loss {run_loss}); lower --lr"
+            )
+        state.epoch = epoch + 1
+        with output_set():  # an epoch's files go out together: a kill loses one epoch at most
+            if val < state.best:
+                state.best, state.best_epoch, state.bad = val, epoch + 1, 0
+                save_model(
+                    out / "model.pt", model, {**run_info, "epoch": epoch + 1, "val_loss": val}
+                )
+            else:
+                state.bad += 1
+            save_epoch(out, state, config, dataset_info, model, opt, sched, dev)
+        bar.set_postfix(train=f"{run_loss / batches:.4f}", val=f"{val:.4f}", kappa=f"{kappa:.0f}")
+        if state.bad >= config.patience:
+            stopped = True
+            break
+    bar.close()
+    return TrainResult(
+        out, len(state.history), state.best_epoch, state.best, stopped,
+        time.perf_counter() - t_run,
+    )  # fmt: skip
+
+
+def _model_and_optimiser(
+    settings: CellSettings,
+    config: TrainConfig,
+    train_split: Split,
+    resume: bool,
+    dev: torch.device,
+) -> tuple[InverseMLP, torch.optim.Optimizer, Any]:
+    """The network (seeded; from ``config.init``'s weights where given and not resuming,
+    its inputs standardised on ``train_split``), AdamW and the cosine schedule."""
     torch.manual_seed(config.seed)
     model = InverseMLP(
         settings.n_asperities,
@@ -184,132 +249,24 @@ def train(
     opt = torch.optim.AdamW(
         model.parameters(), lr=config.lr, weight_decay=config.weight_decay, fused=True
     )
-    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=config.epochs)
-    history: list[dict[str, float]] = []
-    start, best, best_epoch, bad = 0, math.inf, -1, 0
-    if resume:
-        start, best, best_epoch, bad, history = _resume(
-            ckpt_path, config, dataset_info, model, opt, sched, dev
-        )
-    elif ckpt_path.exists():
-        raise MetainterfaceError(f"{out} already holds a run; use --resume or another --out")
-    run_info = {
-        "settings": settings.to_dict(),
-        "model": model.architecture(),
-        "train": asdict(config),
-        "dataset": dataset_info or {},
-        **({"init_sha256": _file_hash(config.init)} if config.init else {}),
-        "provenance": provenance(),
-    }
-    write_text(out / "config.json", strict_json.dumps(run_info, indent=2, default=str) + "\n")
-    schedules = config.schedules
-    t_run = time.perf_counter()
-    stopped = False
-    bar = tqdm(
-        range(start, config.epochs),
-        initial=start,
-        total=config.epochs,
-        unit="epoch",
-        disable=not progress,
-        desc="train",
+    return model, opt, torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=config.epochs)
+
+
+def _validation_loss(
+    model: InverseMLP, val_split: Split, settings: CellSettings, config: TrainConfig, epoch: int
+) -> float:
+    """The epoch's validation loss (the exact contact law); a diverged one is an error."""
+    val = evaluate_loss(
+        model,
+        val_split,
+        settings,
+        config.weights,
+        reads=config.reads,
+        n_delta=config.physics_steps if config.reads == "adhesive" else None,
     )
-    for epoch in bar:
-        t0 = time.perf_counter()
-        kappa, lam = schedules.kappa(epoch), schedules.lam(epoch)
-        run_loss, batches = _train_epoch(model, opt, train_split, settings, config, epoch, dev)
-        lr = opt.param_groups[0]["lr"]
-        sched.step()
-        val = evaluate_loss(
-            model,
-            val_split,
-            settings,
-            config.weights,
-            reads=config.reads,
-            n_delta=config.physics_steps if config.reads == "adhesive" else None,
-        )
-        if not math.isfinite(val):
-            raise MetainterfaceError(
-                f"training diverged at epoch {epoch + 1} (validation loss {val})"
-            )
-        history.append(
-            {
-                "epoch": epoch + 1,
-                "train_loss": run_loss / batches,
-                "val_loss": val,
-                "kappa": kappa,
-                "lambda": lam,
-                "lr": lr,
-                "seconds": time.perf_counter() - t0,
-            }
-        )
-        if not math.isfinite(run_loss):
-            raise MetainterfaceError(
-                f"training diverged at epoch {epoch + 1} (training loss {run_loss}); lower --lr"
-            )
-        with output_set():  # an epoch's files go out together: a kill loses one epoch at most
-            if val < best:
-                best, best_epoch, bad = val, epoch + 1, 0
-                save_model(
-                    out / "model.pt", model, {**run_info, "epoch": epoch + 1, "val_loss": val}
-                )
-            else:
-                bad += 1
-            save_torch(
-                ckpt_path,
-                {
-                    "config": asdict(config),
-                    "dataset": dataset_info or {},
-                    "model": model.state_dict(),
-                    "optimizer": opt.state_dict(),
-                    "scheduler": sched.state_dict(),
-                    "rng": torch.get_rng_state(),
-                    **({"cuda_rng": torch.cuda.get_rng_state(dev)} if dev.type == "cuda" else {}),
-                    "epoch": epoch + 1,
-                    "best": best,
-                    "best_epoch": best_epoch,
-                    "bad": bad,
-                    "history": history,
-                },
-            )
-            write_metrics(out / "metrics.csv", history)
-        bar.set_postfix(train=f"{run_loss / batches:.4f}", val=f"{val:.4f}", kappa=f"{kappa:.0f}")
-        if bad >= config.patience:
-            stopped = True
-            break
-    bar.close()
-    return TrainResult(out, len(history), best_epoch, best, stopped, time.perf_counter() - t_run)
-
-
-def _resume(
-    ckpt_path: Path,
-    config: TrainConfig,
-    dataset_info: dict[str, Any] | None,
-    model: InverseMLP,
-    opt: torch.optim.Optimizer,
-    sched: Any,
-    dev: torch.device,
-) -> tuple[int, float, int, int, list[dict[str, float]]]:
-    """Load a run's checkpoint into model, optimiser, scheduler and the RNGs: (epochs done,
-    best validation loss, its epoch, epochs since, history). A checkpoint made with other
-    settings or on another dataset is refused, naming what differs."""
-    if not ckpt_path.is_file():
-        raise MetainterfaceError(f"--resume: no checkpoint in {ckpt_path.parent}")
-    state = load_torch(ckpt_path, "checkpoint")
-    if state["config"] != asdict(config):
-        changed = sorted(k for k, v in asdict(config).items() if state["config"].get(k, v) != v)
-        was = ", ".join(f"{k} {state['config'].get(k)!r}" for k in changed)
-        raise MetainterfaceError(
-            f"--resume: {ckpt_path} was made with other settings ({was}); give the "
-            "same options or another --out"
-        )
-    _same_dataset(ckpt_path, state.get("dataset"), dataset_info)
-    model.load_state_dict(state["model"])
-    opt.load_state_dict(state["optimizer"])
-    sched.load_state_dict(state["scheduler"])
-    torch.set_rng_state(state["rng"])
-    if dev.type == "cuda" and "cuda_rng" in state:  # dropout draws there on CUDA
-        torch.cuda.set_rng_state(state["cuda_rng"], dev)
-    return state["epoch"], state["best"], state["best_epoch"], state["bad"], state["history"]
+    if not math.isfinite(val):
+        raise MetainterfaceError(f"training diverged at epoch {epoch + 1} (validation loss {val})")
+    return val
 
 
 def _train_epoch(
@@ -407,28 +364,3 @@ def _start_from(model: InverseMLP, path: str, settings: CellSettings, features) 
         first = model.net[0]
         first.bias += first.weight @ shift
         first.weight *= scale[None]
-
-
-def _same_dataset(ckpt_path: Path, stored: dict | None, given: dict | None) -> None:
-    """--resume must continue on the dataset the run started with."""
-    if not stored or not given:
-        return
-    keys = ("fingerprint", "samples", "seed")
-    if any(k in stored and k in given and stored[k] != given[k] for k in keys):
-        raise MetainterfaceError(
-            f"--resume: {ckpt_path} was trained on another dataset ({stored.get('path')}, "
-            f"{stored.get('samples')} samples, seed {stored.get('seed')}); give that --dataset "
-            "or another --out"
-        )
-
-
-def write_metrics(path: Path, history: list[dict[str, float]]) -> None:
-    cols = {k: np.array([row[k] for row in history], dtype=np.float64) for k in METRICS}
-    write_columns(path, cols, what="training metrics")
-
-
-def read_metrics(run_dir: str | os.PathLike[str]) -> dict[str, np.ndarray]:
-    """metrics.csv of a run folder as columns."""
-    from metainterface._files.columns import read_columns
-
-    return read_columns(Path(run_dir) / "metrics.csv", METRICS)
