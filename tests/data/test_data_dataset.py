@@ -10,8 +10,8 @@ import pytest
 import torch
 
 import metainterface
+from metainterface.data import _stream as stream_module
 from metainterface.data import allocate, generate_dataset, load_dataset, split_counts
-from metainterface.data import dataset as dataset_module
 from metainterface.errors import MetainterfaceError
 from metainterface.physics import CellSettings
 from metainterface.physics.sneddon import area, force
@@ -150,8 +150,8 @@ def test_generation_failure_leaves_no_file(tmp_path, settings, monkeypatch):
             raise RuntimeError("boom")
         return curves_numpy(*args, **kwargs)
 
-    curves_numpy = dataset_module.curves_numpy
-    monkeypatch.setattr(dataset_module, "curves_numpy", broken)
+    curves_numpy = stream_module.curves_numpy
+    monkeypatch.setattr(stream_module, "curves_numpy", broken)
     with pytest.raises(RuntimeError, match="boom"):
         generate_dataset(300, 1, settings, tmp_path / "x.npz", progress=False, chunk=100)
     assert list(tmp_path.iterdir()) == []

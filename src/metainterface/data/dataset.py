@@ -20,13 +20,10 @@ chunk is sampled, computed and written straight to its place in the file (``NpzS
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import time
-from collections import deque
 from collections.abc import Iterator, Mapping, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -37,16 +34,14 @@ import torch
 from metainterface._device import resolve_device
 from metainterface._files.atomic import atomic_open, ensure_parent
 from metainterface._files.provenance import provenance
+from metainterface.data._stream import Stream
 from metainterface.data.categories import CATEGORIES, CATEGORY_NAMES
 from metainterface.data.categories import category as find_category
-from metainterface.data.load import CURVE_ARRAYS, FORMAT, SPLIT_FRACTIONS, SPLITS
-from metainterface.data.npz import NpzStreamWriter
+from metainterface.data.load import FORMAT, SPLIT_FRACTIONS, SPLITS
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import CellSettings
-from metainterface.physics.curves import curves_numpy
 
 DEFAULT_CHUNK = 4096  # samples sampled, computed and written together
-_CURVE_CHUNK = 256  # curves_numpy's inner chunk: small temporaries keep the peak RSS low
 DEFAULT_BLOCK = 32768  # largest block one generator draws (fixes the LHS partition)
 
 
@@ -198,38 +193,6 @@ def _rechunk(
         yield take(have)
 
 
-@contextlib.contextmanager
-def _curve_pool(workers: int) -> Iterator[ThreadPoolExecutor]:
-    """Threads that compute curves, each with one torch intra-op thread.
-
-    Chunks run side by side instead of every torch op being split over OpenMP threads, which
-    keeps all cores busy without per-op barriers (on a machine shared with other jobs, OpenMP
-    threads waiting on each other made the same run several times slower). torch's thread
-    setting is per thread; the caller's is restored on exit.
-    """
-    previous = torch.get_num_threads()
-    try:
-        with ThreadPoolExecutor(workers, initializer=torch.set_num_threads, initargs=(1,)) as pool:
-            yield pool
-    finally:
-        torch.set_num_threads(previous)
-
-
-def _keep_examples(
-    kept: dict[int, list[dict[str, np.ndarray]]],
-    wanted: int,
-    cat: np.ndarray,
-    eligible: np.ndarray,
-    arrays: Mapping[str, np.ndarray],
-) -> None:
-    """Add to ``kept`` the first eligible rows of each category until it has ``wanted``."""
-    for c in np.unique(cat):
-        have = sum(len(r["h"]) for r in kept[int(c)])
-        rows = np.flatnonzero((cat == c) & eligible)[: max(0, wanted - have)]
-        if rows.size:
-            kept[int(c)].append({key: value[rows] for key, value in arrays.items()})
-
-
 def generate_dataset(
     samples: int,
     seed: int,
@@ -276,9 +239,7 @@ def generate_dataset(
     workers = min(4, torch.get_num_threads()) if workers is None else workers
     workers = _whole("workers", workers, 1)
     dev = resolve_device(device)
-    # the CPU's curves go in cache-sized pieces over several threads; a GPU takes a chunk whole
-    curve_chunk = _CURVE_CHUNK if dev.type == "cpu" else chunk
-    if dev.type != "cpu":
+    if dev.type != "cpu":  # a GPU takes a chunk whole, from one thread
         workers = 1
     cat_params = _category_params(params)
     started = time.perf_counter()
@@ -288,68 +249,20 @@ def generate_dataset(
     per_split = np.bincount(labels, minlength=len(SPLITS))
     meta_text = _meta_text(samples, seed, settings, block, counts, per_split, cat_params)
     specs = _array_specs(samples, settings, meta_text)
-    cat_names = np.array(CATEGORY_NAMES, dtype=specs["category"][1])
-    split_names = np.array(SPLITS, dtype=specs["split"][1])
-    kept: dict[int, list[dict[str, np.ndarray]]] = {c: [] for c in range(len(CATEGORIES))}
-
-    from tqdm import tqdm
-
     path = Path(out)
     try:
         ensure_parent(path)  # fail before any work on a path that cannot be written
     except MetainterfaceError as exc:
         raise MetainterfaceError(f"cannot write {path}: {exc}") from None
+    blocks = _designs(_plan(counts, block), seed, settings, cat_params)
+    stream = Stream(settings, labels, specs, examples)
     try:
-        with (
-            atomic_open(path, "wb") as fh,
-            tqdm(
-                total=samples,
-                unit="sample",
-                unit_scale=True,
-                desc="generate",
-                delay=2.0,
-                disable=not progress,
-            ) as bar,
-        ):
-            writer = NpzStreamWriter(fh, specs)
-            writer.write("meta", np.array(meta_text, dtype=specs["meta"][1]))
-            pos = 0
-
-            def emit(cat: np.ndarray, gamma: np.ndarray, h: np.ndarray, job: Future) -> None:
-                nonlocal pos
-                curves = job.result()
-                k = len(cat)
-                check_curves(curves, settings, first_row=pos)
-                split = labels[pos : pos + k]
-                writer.write("gamma", gamma)
-                writer.write("h", h)
-                writer.write("category", cat_names[cat])
-                writer.write("split", split_names[split])
-                for name in CURVE_ARRAYS:
-                    writer.write(name, curves[name])
-                if examples:
-                    curves.update(gamma=gamma, h=h)
-                    _keep_examples(kept, examples, cat, split == SPLITS.index("test"), curves)
-                pos += k
-                bar.update(k)
-
-            blocks = _designs(_plan(counts, block), seed, settings, cat_params)
-            in_flight: deque[tuple[np.ndarray, np.ndarray, np.ndarray, Future]] = deque()
-            with _curve_pool(workers) as pool:
-                for cat, gamma, h in _rechunk(blocks, chunk):
-                    gamma, h = sort_and_anchor(gamma, h)
-                    job = pool.submit(
-                        curves_numpy, gamma, h, settings, chunk_size=curve_chunk, device=dev
-                    )
-                    in_flight.append((cat, gamma, h, job))
-                    while len(in_flight) > workers:  # keep the workers busy, memory bounded
-                        emit(*in_flight.popleft())
-                while in_flight:
-                    emit(*in_flight.popleft())
-            writer.close()
+        with atomic_open(path, "wb") as fh:
+            chunks = ((c, *sort_and_anchor(g, h)) for c, g, h in _rechunk(blocks, chunk))
+            stream.write(fh, meta_text, chunks, samples, progress, workers, dev)
     except OSError as exc:
         raise MetainterfaceError(f"cannot write {path}: {exc.strerror or exc}") from None
-
+    kept = stream.kept
     example_arrays = {
         CATEGORIES[c].name: {key: np.concatenate([r[key] for r in rows]) for key in rows[0]}
         for c, rows in kept.items()
@@ -414,20 +327,3 @@ def _array_specs(
         "stiffness_hat": ((samples, steps), np.float32),
         "meta": ((), f"<U{len(meta_text)}"),
     }
-
-
-def check_curves(curves: Mapping[str, np.ndarray], settings: CellSettings, first_row: int) -> None:
-    """Refuse curves that are not finite, or whose scales are not positive (float32 underflow
-    or overflow for an extreme cell): a dataset never holds a silent NaN."""
-    for name in CURVE_ARRAYS:
-        values = np.asarray(curves[name])
-        bad = ~np.isfinite(values)
-        if name in ("p_star_max", "alpha_max"):
-            bad |= ~(values > 0)
-        if bad.any():
-            row = first_row + int(np.flatnonzero(bad.reshape(len(values), -1).any(axis=1))[0])
-            raise MetainterfaceError(
-                f"sample {row}: {name} is not a finite positive number in float32 for this cell "
-                f"(delta_max {settings.delta_max:g}, radius {settings.radius:g}, gamma in "
-                f"[{settings.gamma_min:g}, {settings.gamma_max:g}]); nothing written"
-            )
