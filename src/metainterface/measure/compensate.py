@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.measure.predict import (
     bem_error,
@@ -216,6 +217,7 @@ class Compensation:
         return self.printed is not None
 
 
+@uses_threads()
 def compensate(
     design: Design,
     process: Process | PrintMap,

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from metainterface._threads import uses_threads
 from metainterface.measure.fit import levelled
 from metainterface.measure.register import Registration
 from metainterface.measure.scan import Scan
@@ -276,6 +277,7 @@ def solve_cell(
     )
 
 
+@uses_threads()
 def predict(
     scan: Scan,
     reg: Registration,
