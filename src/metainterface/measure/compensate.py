@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.measure.predict import (
     bem_error,
@@ -216,6 +217,7 @@ class Compensation:
         return self.printed is not None
 
 
+@uses_threads()
 def compensate(
     design: Design,
     process: Process | PrintMap,
@@ -250,13 +252,20 @@ def compensate(
     if loop_grid < LOOP_POINTS * s.n_side:
         loop_grid = grid
 
+    # a geometry judged twice on one grid is solved once: where the coarse grid is the full
+    # one, the final judgement repeats two of the candidates' (2 of 11 solves)
+    seen: dict[tuple[int, bytes, bytes], tuple[float, np.ndarray]] = {}
+
     def judged(g: np.ndarray, h: np.ndarray, m: int) -> tuple[float, np.ndarray]:
-        path = solve_cell(
-            process.made_cell(g, h, design, m), design, p, engine=engine, device=device
-        )
+        key = (m, np.asarray(g, float).tobytes(), np.asarray(h, float).tobytes())
+        if key not in seen:
+            path = solve_cell(
+                process.made_cell(g, h, design, m), design, p, engine=engine, device=device
+            )
+            seen[key] = (float(bem_error(p, path.alpha, target)[0]), path.alpha)
         if report is not None:
             report(1)
-        return float(bem_error(p, path.alpha, target)[0]), path.alpha
+        return seen[key]
 
     before, a_before = judged(design.gamma, h_design, grid)
     # the family's own correction: the map's inverse, as it is and refined with the map inside
@@ -267,6 +276,16 @@ def compensate(
     candidates = [(g0, h0), family_own]
     best: tuple[float, np.ndarray, np.ndarray, np.ndarray] | None = None
     p_t, a_t = target
+    # a round whose best is the last round's refines from the same start towards the same
+    # targets: those refinements (150 steps each) are made once
+    refinements: dict[tuple[bytes, ...], tuple[np.ndarray, np.ndarray]] = {}
+
+    def refined(g: np.ndarray, h: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        key = tuple(np.asarray(v, float).tobytes() for v in (g, h, a))
+        if key not in refinements:
+            refinements[key] = _refine(g, h, pmap, design, (p_t, a), model, steps)
+        return refinements[key]
+
     # candidates judged on the coarse grid (a quarter of the cost; its discretisation is
     # common to them all), the best one again on the full grid
     for i in range(rounds + 1):
@@ -282,10 +301,7 @@ def compensate(
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(fam[0] > 0, best[3] / fam[0], 1.0)
         ratio = np.interp(p_t, p, np.clip(np.nan_to_num(ratio, nan=1.0, posinf=1.0), 0.2, 5.0))
-        candidates = [
-            _refine(best[1], best[2], pmap, design, (p_t, a_t / ratio**lam), model, steps)
-            for lam in DAMPING
-        ]
+        candidates = [refined(best[1], best[2], a_t / ratio**lam) for lam in DAMPING]
     assert best is not None
     # on the full grid: the coarse grid's best, and the family's own correction (where the
     # made cell is nearly the family's, the coarse grid's own error can misrank them)

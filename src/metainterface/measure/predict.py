@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from metainterface._threads import uses_threads
 from metainterface.measure.fit import levelled
 from metainterface.measure.register import Registration
 from metainterface.measure.scan import Scan
@@ -76,20 +77,25 @@ def measured_cell(scan: Scan, reg: Registration, design: Design, grid: int) -> M
     zf = np.where(ok, z, 0.0)
     width, height = scan.size
     cu, cv = reg.lattice.to_cell(np.array([0, width, 0, width]), np.array([0, 0, height, height]))
+    okf = ok.astype(float)
     total = np.zeros_like(u)
     count = np.zeros_like(u)
     for cy in range(math.floor(cv.min() / side) - 1, math.ceil(cv.max() / side) + 1):
         for cx in range(math.floor(cu.min() / side) - 1, math.ceil(cu.max() / side) + 1):
             x, y = reg.lattice.to_scan(u + cx * side, v + cy * side)
-            coords = np.stack([y / scan.dy, x / scan.dx])
-            inside = (coords[0] >= 0) & (coords[0] <= scan.shape[0] - 1)
-            inside &= (coords[1] >= 0) & (coords[1] <= scan.shape[1] - 1)
+            row, col = y / scan.dy, x / scan.dx
+            inside = (row >= 0) & (row <= scan.shape[0] - 1)
+            inside &= (col >= 0) & (col <= scan.shape[1] - 1)
             if not inside.any():
                 continue
-            w = ndimage.map_coordinates(ok.astype(float), coords, order=1, mode="nearest")
+            # only the points this copy shows are looked up (most of the grid lies outside)
+            coords = np.stack([row[inside], col[inside]])
+            w = ndimage.map_coordinates(okf, coords, order=1, mode="nearest")
             val = ndimage.map_coordinates(zf, coords, order=1, mode="nearest")
-            use = inside & (w > 0.999)  # all four neighbours measured
-            total[use] += val[use] / w[use]
+            good = w > 0.999  # all four neighbours measured
+            use = np.zeros_like(inside)
+            use[inside] = good
+            total[use] += val[good] / w[good]
             count[use] += 1
     fitted = lattice_surface(u, v, -reg.h, reg.gamma, s)
     seen = count > 0
@@ -276,6 +282,7 @@ def solve_cell(
     )
 
 
+@uses_threads()
 def predict(
     scan: Scan,
     reg: Registration,

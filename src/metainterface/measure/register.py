@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.measure.fit import AsperityFits, fit_asperities, fit_lattice
 from metainterface.measure.lattice import Lattice
@@ -72,6 +73,7 @@ def check_size(scan: Scan, design: Design) -> float:
     return pitch
 
 
+@uses_threads()
 def register(scan: Scan, design: Design) -> Registration:
     """Register ``scan`` (lengths in R) to ``design``; see the module docstring."""
     pitch = check_size(scan, design)

@@ -8,6 +8,7 @@ import os
 from collections.abc import Sequence
 from typing import Any
 
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.measure.compensate import compensate as compensate_design
 from metainterface.measure.compensate import process_from, solves
@@ -18,6 +19,7 @@ from metainterface.measure.scan import as_scan
 from metainterface.physics.cell import Design
 
 
+@uses_threads()
 def measure(
     scan: Any,
     design: Design | str | os.PathLike[str],
