@@ -27,6 +27,7 @@ def tiny(tmp_path_factory):
     return reproduce(tmp_path_factory.mktemp("reproduce"), scale="tiny", progress=False)
 
 
+@pytest.mark.long
 def test_every_figure_has_a_png_a_pdf_and_a_caption(tiny):
     assert set(tiny.figures) == set(FIGURES)
     md = tiny.results_md.read_text()
@@ -39,6 +40,7 @@ def test_every_figure_has_a_png_a_pdf_and_a_caption(tiny):
     assert set(tiny.seconds) == {"fig1", "fig3", "fig4", "fig5", "fig6"}
 
 
+@pytest.mark.long
 def test_results_json_holds_the_returned_numbers_and_settings(tiny):
     record = json.loads((tiny.out_dir / "results.json").read_text())
     assert record["numbers"] == tiny.numbers
@@ -46,6 +48,7 @@ def test_results_json_holds_the_returned_numbers_and_settings(tiny):
     assert record["paper"]["bem_max_rel_err"]["value"] == 0.03
 
 
+@pytest.mark.long
 def test_results_md_tables_show_the_computed_numbers(tiny):
     md = tiny.results_md.read_text()
     for cat, r in tiny.numbers["fig3"]["evaluation"]["categories"].items():
@@ -64,6 +67,7 @@ def test_results_md_tables_show_the_computed_numbers(tiny):
     assert f"| 1 | {w['gamma_true'][0]:.3f} | {w['gamma_pred'][0]:.3f} |" in md
 
 
+@pytest.mark.long
 def test_a_changed_computation_shows_in_results_md(tmp_path, monkeypatch):
     real_force, real_design = stages.force, stages.design
     monkeypatch.setattr(stages, "force", lambda *a, **k: 1.01 * real_force(*a, **k))

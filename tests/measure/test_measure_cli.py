@@ -26,6 +26,7 @@ def files(tmp_path_factory):
     return folder, z.shape[1] * dx * R
 
 
+@pytest.mark.long
 def test_measure_writes_its_files(files, capsys):
     folder, width = files
     out = folder / "out"

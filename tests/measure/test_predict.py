@@ -154,6 +154,7 @@ def test_map_from_two_scans(design, measured):
     assert comp.error_after < 0.01
 
 
+@pytest.mark.long
 def test_a_shape_the_family_cannot_describe_is_reported(design):
     # tips flattened to caps of radius 20 R over half of a_max: no power law fits them, so
     # the BEM on the measured cell and the fitted model part, and the result says where

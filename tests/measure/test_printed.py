@@ -59,6 +59,7 @@ def test_any_orientation_is_found(design, angle, mirrored):
     np.testing.assert_allclose(reg.gamma[seen], design.gamma[seen] + 0.15, atol=0.06)
 
 
+@pytest.mark.long
 def test_the_part_as_made_is_predicted_and_corrected(design, tmp_path):
     """The issue's case: flat tips and 1 um layers, turned about 90 degrees, written
     mirrored as a text matrix in um (no size, no unit: given on the command line)."""
@@ -103,6 +104,7 @@ def test_the_part_as_made_is_predicted_and_corrected(design, tmp_path):
     assert comp.extras["physical"]["radius_m"] == pytest.approx(R)
 
 
+@pytest.mark.long
 def test_layers_flat_tips_and_noise_are_read(design):
     # 0.7 um layers, no cut: the step
     z = _scan(design, Process(layer=0.7e-6, phase=0.2e-6), angle_deg=3.0)
@@ -130,6 +132,7 @@ def test_layers_flat_tips_and_noise_are_read(design):
     assert depth == pytest.approx(1e-6, abs=0.2e-6)
 
 
+@pytest.mark.long
 def test_a_height_unit_slip_is_flagged(design):
     z = _scan(design, Process(), angle_deg=1.0)
     with pytest.warns(mi.UnitSlipWarning, match="height unit slip") as caught:
@@ -151,6 +154,7 @@ def test_extra_material_is_named(design):
     assert any("asperity 4: extra material" in w for w in res.warnings())
 
 
+@pytest.mark.long
 def test_an_adhesive_part_is_measured_against_its_adhesive_law():
     # PDMS-like: w = 50 mJ/m^2, E* = 2.4 MPa; the target is the adhesive model's curve (JKR
     # asperities summed, closed forms). The measured cell, in the JKR-limit BEM, meets it

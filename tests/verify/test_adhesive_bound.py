@@ -37,7 +37,7 @@ def _error(alpha, p, target):
     return float(np.linalg.norm(alpha - t) / np.linalg.norm(t))
 
 
-@pytest.mark.parametrize("grid", [64, 128])
+@pytest.mark.parametrize("grid", [64, pytest.param(128, marks=pytest.mark.long)])
 def test_the_bound_holds_against_jkr_and_a_finer_grid(hertz, grid):
     design, target = hertz
     model = mi.Independent(adhesion=W)
