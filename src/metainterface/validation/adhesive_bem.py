@@ -51,7 +51,6 @@ import torch
 from torch import Tensor
 
 from metainterface.errors import MetainterfaceError
-from metainterface.validation.torch_bem import _dot as _bdot
 from metainterface.validation.torch_bem import displacement, unit_kernel
 
 #: The edge-element factor c_e of the JKR (Pohrt-Popov) criterion for this kernel: a bonded
@@ -77,6 +76,11 @@ CLOSING_FACTOR = 2.0 / math.sqrt(math.pi)
 #: Conjugate-gradient iterations at most per solve, and the relative residual aimed at.
 MAX_ITER = 5000
 TOLERANCE = 1e-10
+#: The preconditioner's precision: float32 FFTs (about half the cost of float64 at 384^2)
+#: change only the search directions, not the residual the solve is held to, which is
+#: float64: the same iterations and contact sets as a float64 preconditioner on the
+#: 9-asperity benchmark path.
+PRECONDITIONER_DTYPE = torch.complex64
 
 
 def inverse_kernel(m: int, side: float, device: torch.device) -> Tensor:
@@ -194,6 +198,15 @@ def solve_maugis(
     return AdhesiveSolution(pressure, g, contact, p_star.reshape(-1), alpha, err, it)
 
 
+def _apply(x: Tensor, kernel: Tensor) -> Tensor:
+    """(B, M, M) the operator of a real Fourier kernel applied to x (B, M, M); kernel
+    (1 or B, M, M // 2 + 1) complex (``torch_bem.displacement``'s transforms; a real kernel
+    is cast to complex at every product, a copy of the spectrum)."""
+    m = x.shape[-1]
+    spectrum = torch.fft.fft(torch.fft.rfft(x, dim=-1), dim=-2).mul_(kernel)
+    return torch.fft.irfft(torch.fft.ifft(spectrum, dim=-2), n=m, dim=-1)
+
+
 def _bonded(
     z: Tensor,
     c: Tensor,
@@ -203,53 +216,87 @@ def _bonded(
     tolerance: float,
     max_iter: int,
     stiffness: Tensor | None = None,
-) -> tuple[Tensor, Tensor, Tensor]:
+    u0: Tensor | None = None,
+) -> tuple[Tensor, Tensor]:
     """Pressures on the contact sets (B, M, M) bool with g = u - z - c = 0 there, p = 0 off
-    them: preconditioned conjugate gradients on K_CC p_C = (z + c)_C from p0 (B, M, M),
+    them: preconditioned conjugate gradients on K_CC p_C = (z + c)_C from p0 (B, M, M) [E*],
     to a relative residual ||(z + c - u)_C|| / ||(z + c)_C|| <= ``tolerance``.
 
     fwd: (1 or B, M, M // 2 + 1) the compliance u_hat / p_hat; stiffness: its inverse
-    (``inverse_kernel``, built from fwd when None), the preconditioner. Returns p
-    (B, M, M) [E*], u (B, M, M) [length] the displacement of p on the whole cell (updated
-    with the iterates, so a caller reads the gap off the contact without another FFT), and
-    the residual (B,) the iteration reached (an item above ``tolerance`` did not converge).
+    (``inverse_kernel``; from fwd when None), the preconditioner; both real or complex. u0:
+    the displacement of p0 (B, M, M) [length] where p0 is 0 off the contact, or None.
+    Returns p (B, M, M), 0 off the contact, and the relative residual (B,) of the
+    iteration (an item above ``tolerance`` did not converge).
 
     The preconditioner is the compliance's inverse on the whole half-space, kept to the
     contact (as ``torch_bem``'s, Vollebregt 2014): the compliance's condition number grows
-    with the contact's size in grid points, its inverse takes most of that away. Measured
-    on a 9-asperity cell, 13-16 iterations a solve instead of 45-62, at two FFT pairs an
-    iteration instead of one (benchmarks/results/adhesion.md).
+    with the contact's size in grid points, its inverse takes most of that away (13-16
+    iterations a solve instead of 45-62 on the 9-asperity benchmark cell, at two FFT pairs
+    an iteration instead of one). The iteration's vectors hold the contact's points only
+    (gathered over the batch; a dot product is a sum per item), so only the FFTs touch the
+    whole grid: the contact is a tenth of it or less in a check.
     """
+    b, m, _ = z.shape
+    n = m * m
     if stiffness is None:
         stiffness = torch.where(fwd > 0, 1.0 / torch.where(fwd > 0, fwd, 1.0), 0.0)
-    mask = contact.to(z.dtype)
-    rhs = (z + c) * mask
-    p = p0 * mask
-    # u is computed afresh from p here, so the residual each solve starts from (and the one
-    # a solve of an unchanged set ends on) is the true one, not the recursion's
-    u = displacement(p, fwd)
-    r = rhs - u * mask
-    scale = _bdot(rhs, rhs).sqrt().clamp_min(1e-300)
-    w = displacement(r, stiffness).mul_(mask)
+    fwd, stiffness = fwd.to(torch.complex128), stiffness.to(PRECONDITIONER_DTYPE)
+    idx = contact.reshape(-1).nonzero().squeeze(1)  # the contact's points, flat over B
+    if idx.numel() == 0:  # no contact: no pressure (an FFT of no rows is an error)
+        return torch.zeros_like(z), torch.zeros(b, dtype=z.dtype, device=z.device)
+    item = torch.div(idx, n, rounding_mode="floor")
+    # The rows holding a contact point (of any item): the transforms along the rows run on
+    # those only, zero rows transform to zero and the other rows' results are not read (a
+    # third to a half of the rows in a check: a quarter of the float64 transform's cost)
+    row = torch.div(idx % n, m, rounding_mode="floor")
+    rows, rank = torch.unique(row, sorted=True, return_inverse=True)
+    pos = (item * rows.numel() + rank) * m + idx % m  # in a (B, rows, M) buffer
+    fields = {  # 0 off the contact, always
+        t: torch.zeros(b * rows.numel() * m, dtype=t, device=z.device)
+        for t in {torch.float64, stiffness.real.dtype}
+    }
+    spectra = {
+        t: torch.zeros(b, m, m // 2 + 1, dtype=k.dtype, device=z.device)
+        for t, k in ((torch.float64, fwd), (stiffness.real.dtype, stiffness))
+    }
+
+    def apply(kernel: Tensor, v: Tensor) -> Tensor:  # the operator on the contact's points
+        t = kernel.real.dtype
+        field = fields[t]
+        field[pos] = v.to(t)
+        spectrum = spectra[t]
+        spectrum[:, rows] = torch.fft.rfft(field.view(b, -1, m), dim=-1)
+        out = torch.fft.ifft(torch.fft.fft(spectrum, dim=-2).mul_(kernel), dim=-2)[:, rows]
+        return torch.fft.irfft(out, n=m, dim=-1).reshape(-1)[pos].to(v.dtype)
+
+    def dot(a: Tensor, v: Tensor) -> Tensor:  # (B,) sums over each item's points
+        return torch.zeros(b, dtype=z.dtype, device=z.device).index_add_(0, item, a * v)
+
+    rhs = (z + c).reshape(-1)[idx]
+    p = p0.reshape(-1)[idx]
+    u = apply(fwd, p) if u0 is None else u0.reshape(-1)[idx]
+    r = rhs - u
+    scale = dot(rhs, rhs).sqrt().clamp_min(1e-300)
+    w = apply(stiffness, r)
     d = w
-    rw = _bdot(r, w)
-    rr = _bdot(r, r)
+    rw = dot(r, w)
+    rr = dot(r, r)
     for _ in range(max_iter):
         if bool((rr.sqrt() <= tolerance * scale).all()):
             break
-        ud = displacement(d, fwd)
-        ad = ud * mask
-        step = rw / _bdot(d, ad).clamp_min(1e-300)
+        ad = apply(fwd, d)
+        step = (rw / dot(d, ad).clamp_min(1e-300))[item]
         p = p.addcmul(step, d)
-        u = u.addcmul(step, ud)
         r = r.addcmul(step, ad, value=-1.0)
-        rr = _bdot(r, r)
-        w = displacement(r, stiffness).mul_(mask)
-        rw_new = _bdot(r, w)
+        rr = dot(r, r)
+        w = apply(stiffness, r)
+        rw_new = dot(r, w)
         # an item already converged has r = 0: beta 0 / 0 -> 0 (clamped), d stays finite
-        d = w.addcmul(d, rw_new / rw.clamp_min(1e-300))
+        d = w.addcmul(d, (rw_new / rw.clamp_min(1e-300))[item])
         rw = rw_new
-    return p, u, (rr.sqrt() / scale).reshape(-1)
+    out = torch.zeros(b * n, dtype=z.dtype, device=z.device)
+    out[idx] = p
+    return out.view(b, m, m), (rr.sqrt() / scale).reshape(-1)
 
 
 def _neighbours(mask: Tensor) -> Tensor:
@@ -299,11 +346,13 @@ def solve_jkr(
         contact = (-z - c) <= 0
     g_close = CLOSING_FACTOR * math.sqrt(2.0 * work * spacing)
     p = torch.zeros_like(z) if pressure is None else pressure
-    stiffness = inverse_kernel(m, side, z.device)
+    stiffness = inverse_kernel(m, side, z.device).to(torch.complex128)
+    fwd = fwd.to(torch.complex128)
     res = torch.zeros(b, dtype=z.dtype, device=z.device)
     came_off = torch.zeros_like(contact)
+    u = None  # the displacement of p where p is 0 off the contact, else None
     for _ in range(max_updates):
-        p, u, res = _bonded(z, c, contact, fwd, p, tolerance, max_iter, stiffness)
+        p, res = _bonded(z, c, contact, fwd, p, tolerance, max_iter, stiffness, u)
         if not bool((res <= tolerance).all()):
             # a bonded solve stopped short is not a contact state: its pressures, and the
             # points it lets come off, are the iteration's, not the contact's
@@ -311,16 +360,16 @@ def solve_jkr(
                 f"adhesive BEM (JKR) did not converge: conjugate-gradient residual "
                 f"{float(res.max()):.3g} > tolerance {tolerance:g} after {max_iter} iterations"
             )
+        # the displacement afresh (carried with the iterates it would cost a full-grid
+        # update an iteration, more than this FFT pair), so the residual below is the true one
+        u = _apply(p, fwd)
         g = u - z - c
         beside = _neighbours(contact) & ~contact
         attach = ~contact & ((g < 0) | (beside & ~came_off & (g < g_close)))
         detach = contact & (p < -sigma_c)
         if not bool((attach | detach).any()):
-            # the state returned: its displacement afresh, so its residual is the true one
-            # (the iteration's recursion drifts by rounding); a true residual above the
-            # tolerance (the recursion's just below it) takes another solve of the same set
-            u = displacement(p, fwd)
-            g = u - z - c
+            # the state returned; the iteration's residual is a recursion's, which drifts by
+            # rounding: a true residual above the tolerance takes another solve of the set
             rhs_norm = ((z + c) * contact).square().sum(dim=(1, 2)).sqrt()
             res = (g * contact).square().sum(dim=(1, 2)).sqrt() / rhs_norm.clamp_min(1e-300)
             if bool((res <= tolerance).all()):
@@ -328,6 +377,8 @@ def solve_jkr(
             continue
         came_off = came_off | detach
         contact = (contact | attach) & ~detach
+        if bool(detach.any()):
+            u = None  # p loses the points that came off: its displacement changes
     else:
         raise MetainterfaceError(
             f"adhesive BEM (JKR) found no stable contact set in {max_updates} updates"
@@ -353,7 +404,7 @@ def edge_factor(grid: int = 256, radius_cells: float = 0.125) -> float:
     contact = torch.as_tensor(disc)[None]
     fwd = forward_kernel(grid, side, torch.device("cpu"))
     c = torch.full((1, 1, 1), -1e-3, dtype=torch.float64)  # a pull of 1e-3 L
-    p, _, _ = _bonded(heights, c, contact, fwd, torch.zeros_like(heights), 1e-12, 10000)
+    p, _ = _bonded(heights, c, contact, fwd, torch.zeros_like(heights), 1e-12, 10000)
     force = float(p.sum()) * dx * dx
     a = math.sqrt(disc.sum() * dx * dx / math.pi)
     k_i = abs(force) / (2.0 * math.sqrt(math.pi * a**3))
@@ -381,7 +432,7 @@ def pull_off_factor(grid: int = 128, radius_cells: float = 0.1, step: float = 0.
         return abs(float(p.sum())) * dx * dx / (2.0 * math.sqrt(math.pi * a**3))
 
     fwd = forward_kernel(grid, side, z.device)
-    unit, _, _ = _bonded(z, -torch.ones(1, 1, 1, dtype=z.dtype), contact, fwd, z * 0, 1e-12, 10000)
+    unit, _ = _bonded(z, -torch.ones(1, 1, 1, dtype=z.dtype), contact, fwd, z * 0, 1e-12, 10000)
     pull = k_c / k_of(unit, disc.sum())  # the pull at which the bonded punch has K_c
     z_bar = -float(z.mean())
     n0, k_max, pressure = float(disc.sum()), 0.0, None
