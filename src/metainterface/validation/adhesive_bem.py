@@ -198,10 +198,18 @@ def solve_maugis(
     return AdhesiveSolution(pressure, g, contact, p_star.reshape(-1), alpha, err, it)
 
 
+def _spectral(kernel: Tensor, dtype: torch.dtype) -> Tensor:
+    """A real or complex kernel (1 or B, M, M // 2 + 1) as ``_apply`` takes it: complex (a
+    real kernel is cast at every product, a copy of the spectrum) and laid out as the
+    transform along the columns returns its spectrum (transposed on the CPU), so the
+    product is one pass over matching strides. A no-op on a kernel already so."""
+    return kernel.to(dtype).transpose(-1, -2).contiguous().transpose(-1, -2)
+
+
 def _apply(x: Tensor, kernel: Tensor) -> Tensor:
     """(B, M, M) the operator of a real Fourier kernel applied to x (B, M, M); kernel
-    (1 or B, M, M // 2 + 1) complex (``torch_bem.displacement``'s transforms; a real kernel
-    is cast to complex at every product, a copy of the spectrum)."""
+    (1 or B, M, M // 2 + 1) complex, best from ``_spectral`` (``torch_bem.displacement``'s
+    transforms)."""
     m = x.shape[-1]
     spectrum = torch.fft.fft(torch.fft.rfft(x, dim=-1), dim=-2).mul_(kernel)
     return torch.fft.irfft(torch.fft.ifft(spectrum, dim=-2), n=m, dim=-1)
@@ -240,7 +248,7 @@ def _bonded(
     n = m * m
     if stiffness is None:
         stiffness = torch.where(fwd > 0, 1.0 / torch.where(fwd > 0, fwd, 1.0), 0.0)
-    fwd, stiffness = fwd.to(torch.complex128), stiffness.to(PRECONDITIONER_DTYPE)
+    fwd, stiffness = _spectral(fwd, torch.complex128), _spectral(stiffness, PRECONDITIONER_DTYPE)
     idx = contact.reshape(-1).nonzero().squeeze(1)  # the contact's points, flat over B
     if idx.numel() == 0:  # no contact: no pressure (an FFT of no rows is an error)
         return torch.zeros_like(z), torch.zeros(b, dtype=z.dtype, device=z.device)
@@ -346,8 +354,8 @@ def solve_jkr(
         contact = (-z - c) <= 0
     g_close = CLOSING_FACTOR * math.sqrt(2.0 * work * spacing)
     p = torch.zeros_like(z) if pressure is None else pressure
-    stiffness = inverse_kernel(m, side, z.device).to(torch.complex128)
-    fwd = fwd.to(torch.complex128)
+    stiffness = _spectral(inverse_kernel(m, side, z.device), PRECONDITIONER_DTYPE)
+    fwd = _spectral(fwd, torch.complex128)
     res = torch.zeros(b, dtype=z.dtype, device=z.device)
     came_off = torch.zeros_like(contact)
     u = None  # the displacement of p where p is 0 off the contact, else None
