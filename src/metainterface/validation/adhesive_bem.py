@@ -37,7 +37,8 @@ the two rules until it no longer changes, and the state returned has its displac
 (and so its residual) computed afresh. The transforms along the rows run on the rows that
 hold a point of C only, and the preconditioner's in float32 (the residual the solve is
 held to is float64's): the benchmark check (``benchmarks/bench_adhesive_bound.py``) went
-from 94 s to 29 s with the same contact fractions (benchmarks/results/adhesion.md). c_e
+from 157 s to 16-18 s beside other work (load ~3-4) with the same contact fractions
+(benchmarks/results/adhesion.md). c_e
 (``EDGE_FACTOR``) is calibrated for this kernel on a flat punch (it comes off at Kendall's
 F = sqrt(8 pi w E* a^3)), see ``pull_off_factor``, and c_g follows from the crack's
 opening; the JKR sphere is then an independent check: a Hertz asperity's contact fraction
