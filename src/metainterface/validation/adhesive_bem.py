@@ -31,7 +31,7 @@ loading too: the reversible JKR branch that the forward model follows; a point t
 off in a solve closes again only by overlap, so the updates cannot cycle). At each mean
 gap the bonded problem (g = 0 on the contact set C, p = 0 off it) is linear and solved by
 conjugate gradients on the points of C, preconditioned with the half-space's stiffness
-E* |q| / 2 kept to C (as ``torch_bem``; 13-16 iterations a solve on a 9-asperity cell
+E* |q| / 2 kept to C (as ``torch_bem``; about 13 iterations a solve on a 9-asperity cell
 instead of 45-62), each set warm-started from the last set's pressures; C is updated by
 the two rules until it no longer changes, and the state returned has its displacement
 (and so its residual) computed afresh. The transforms along the rows run on the rows that
@@ -246,7 +246,7 @@ def _bonded(
 
     The preconditioner is the compliance's inverse on the whole half-space, kept to the
     contact (as ``torch_bem``'s, Vollebregt 2014): the compliance's condition number grows
-    with the contact's size in grid points, its inverse takes most of that away (13-16
+    with the contact's size in grid points, its inverse takes most of that away (about 13
     iterations a solve instead of 45-62 on the 9-asperity benchmark cell, at two FFT pairs
     an iteration instead of one). The iteration's vectors hold the contact's points only
     (gathered over the batch; a dot product is a sum per item), so only the FFTs touch the
