@@ -45,6 +45,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import torch
 
+from metainterface._threads import uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
@@ -153,6 +154,11 @@ class BoundedCheck:
     seconds: float
 
 
+# One thread, as the CLI and the design loop run it (``_threads``: light work): its FFTs of
+# 192^2-384^2 gain little from a second thread on an idle machine and lose much when
+# another process holds a core (the benchmark cell: 40 s on two threads, 30 s on one,
+# beside a busy test suite, load ~5)
+@uses_threads()
 def bounded_check(
     design: Design,
     target: Target,
