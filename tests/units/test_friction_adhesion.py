@@ -1,6 +1,7 @@
 """Friction laws with adhesion (issue 38): an offset F_f(0) > 0 accepted and kept, the fit's
 free offset, the adhesive reach, and a law from a held-back adhesive cell designed."""
 
+import importlib
 import warnings
 
 import numpy as np
@@ -214,9 +215,13 @@ def test_design_takes_a_work_of_adhesion_with_its_scale():
         mi.design("bilinear", scale=mi.Scale(work_of_adhesion="50mJ/m2"), **quick)
 
 
-def test_the_notes_are_of_the_design_the_bem_corrected(tmp_path):
+def test_the_notes_are_of_the_design_the_bem_corrected(tmp_path, monkeypatch):
     """A design corrected in BEM is another design: its friction at zero load and pull-off
     force are stated for it, not for the design before the correction."""
+    # on this coarse grid the check's own error is within half its BEM error, where the
+    # correction rightly stops before a step (tests/verify/test_accuracy.py): one is forced
+    correct_module = importlib.import_module("metainterface.verify.correct")
+    monkeypatch.setattr(correct_module, "settled", lambda check: False)
     path = _write(tmp_path, *_held_back_law())
     scale = dict(shear_strength=TAU, modulus=E, radius=R, area=AREA, fit="never")
     target = mi.Target.from_friction(path, work_of_adhesion="50mJ/m2", **scale)
