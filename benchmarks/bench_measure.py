@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import metainterface as mi
-from metainterface.measure.predict import curve_errors, target_of
+from metainterface.measure.predict import target_of
+from metainterface.physics.grid_error import grid_curve_error
 from metainterface.validation import owner_map, solve_path
 
 R = 0.5e-3
@@ -83,8 +84,8 @@ def main() -> None:
     g = np.arange(m) * side / m
     exact = made_surface(*np.meshgrid(g, g), design, gamma_made, h_made)
     ref = solve_path(exact - exact.max(), side, p.p_star, owner_map(3, m), 9)
-    made_next = curve_errors(
-        (comp.printed.gamma + 0.15)[None], (0.85 * comp.printed.h)[None], design,
+    made_next = grid_curve_error(
+        (comp.printed.gamma + 0.15)[None], (0.85 * comp.printed.h)[None], design.settings,
         target_of(design),
     )[0][0]  # fmt: skip
     print(

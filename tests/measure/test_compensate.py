@@ -11,7 +11,8 @@ import pytest
 from made_parts import example
 
 from metainterface.measure.compensate import PrintMap, compensate, fit_map
-from metainterface.measure.predict import curve_errors, target_of
+from metainterface.measure.predict import target_of
+from metainterface.physics.grid_error import grid_curve_error
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +59,7 @@ def test_the_print_made_by_the_map_meets_the_target(design):
     # the design's first asperity sits on the lower bound: it cannot be printed 0.15 lower
     assert comp.printed.gamma[0] == pytest.approx(s.gamma_min, abs=0.01)
     g, h = pmap.made(comp.printed.gamma, comp.printed.h)
-    err, cover = curve_errors(g[None], h[None], design, target_of(design))
+    err, cover = grid_curve_error(g[None], h[None], design.settings, target_of(design))
     assert err[0] == pytest.approx(comp.error_family, abs=1e-9)
     assert err[0] < 0.01 and cover[0] == 1.0
     # judged in BEM on the made cell (power laws only here): as good as the family says

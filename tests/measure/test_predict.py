@@ -11,7 +11,8 @@ import pytest
 from made_parts import Made, example, made_cell, scan_of
 
 import metainterface as mi
-from metainterface.measure.predict import curve_errors, target_of
+from metainterface.measure.predict import target_of
+from metainterface.physics.grid_error import grid_curve_error
 from metainterface.validation import owner_map, solve_path
 
 st = pytest.importorskip("SurfaceTopography")
@@ -71,7 +72,7 @@ def test_bem_of_the_scan_is_the_bem_of_the_made_cell(design, measured):
 def test_made_error_is_the_made_cells(design, measured):
     # the error of the made part's closed-form model, against the design's target
     gamma, h = MADE.params(design)
-    exact, _ = curve_errors(gamma[None], h[None], design, target_of(design))
+    exact, _ = grid_curve_error(gamma[None], h[None], design.settings, target_of(design))
     assert measured.prediction.error_fit == pytest.approx(exact[0], rel=0.03)
     assert measured.error == pytest.approx(exact[0], abs=0.01)
     assert measured.error > 0.05  # far from the design's promise
@@ -88,7 +89,7 @@ def test_compensated_design_made_with_the_same_errors_meets_the_target(design, c
     s = design.settings
     assert (printed.gamma >= s.gamma_min).all() and (printed.gamma <= s.gamma_max).all()
     gamma, h = MADE.params(printed)  # printed, then made as before
-    err, cover = curve_errors(gamma[None], h[None], design, target_of(design))
+    err, cover = grid_curve_error(gamma[None], h[None], design.settings, target_of(design))
     assert err[0] < 0.01 and cover[0] == 1.0
     assert comp.error_before > 0.05 and comp.error_after < 0.01
 

@@ -32,7 +32,6 @@ from metainterface.errors import MetainterfaceError
 from metainterface.measure.predict import (
     bem_error,
     coarse_grid,
-    curve_errors,
     loads_over,
     model_alpha,
     solve_cell,
@@ -42,7 +41,7 @@ from metainterface.measure.register import Registration
 from metainterface.measure.shapes import Shapes, Terraces, on_levels
 from metainterface.measure.surface import asperity_index, lattice_surface
 from metainterface.physics.cell import Design
-from metainterface.physics.grid_error import error_grid
+from metainterface.physics.grid_error import error_grid, grid_curve_error
 from metainterface.physics.registry import get_model
 
 #: Steps of the refinement with the map inside.
@@ -313,42 +312,34 @@ def compensate(
     assert best is not None
     after, g1, h1, a_after = best
     gm, hm = pmap.made(g1, h1)
-    family, _ = curve_errors(gm[None], hm[None], design, target, model)
+    family, _ = grid_curve_error(gm[None], hm[None], design.settings, target, model)
     limits = _limits(design, g1, p, a_after, target, after)
+    printed = None
     if after >= before:
         limits.insert(
             0,
             f"no correction beats the design printed as it is ({100 * before:.3g} % made "
             f"error; the best correction reads {100 * after:.3g} %): none is written",
         )
-        return Compensation(
-            printed=None,
-            process=process,
-            error_before=before,
-            error_after=before,
-            error_family=float(family[0]),
-            p_star=p,
-            alpha_before=a_before,
-            alpha_after=a_before,
-            limits=limits,
+        after, a_after = before, a_before
+    else:
+        extras = {k: v for k, v in design.extras.items() if k not in ("provenance", "physical")}
+        extras["target"] = {"p_star": [float(v) for v in p_t], "alpha": [float(v) for v in a_t]}
+        if radius_m is not None:
+            extras["physical"] = {"radius_m": float(radius_m)}
+        extras["compensation"] = {
+            "predicted_made_error_before": before,
+            "predicted_made_error_after": after,
+            "predicted_by": f"BEM of the predicted made cell, {grid}^2, {loads} loads",
+            "candidates_judged_on": f"{loop_grid}^2",
+            "family_error_after": float(family[0]),
+            "process": process.to_dict(radius_m if radius_m is not None else 1.0),
+            "process_units": "um" if radius_m is not None else "units of R (no radius given)",
+            "limits": limits,
+        }
+        printed = Design(
+            gamma=np.clip(g1, s.gamma_min, s.gamma_max), h=h1 - h1.min(), settings=s, extras=extras
         )
-    extras = {k: v for k, v in design.extras.items() if k not in ("provenance", "physical")}
-    extras["target"] = {"p_star": [float(v) for v in p_t], "alpha": [float(v) for v in a_t]}
-    if radius_m is not None:
-        extras["physical"] = {"radius_m": float(radius_m)}
-    extras["compensation"] = {
-        "predicted_made_error_before": before,
-        "predicted_made_error_after": after,
-        "predicted_by": f"BEM of the predicted made cell, {grid}^2, {loads} loads",
-        "candidates_judged_on": f"{loop_grid}^2",
-        "family_error_after": float(family[0]),
-        "process": process.to_dict(radius_m if radius_m is not None else 1.0),
-        "process_units": "um" if radius_m is not None else "units of R (no radius given)",
-        "limits": limits,
-    }
-    printed = Design(
-        gamma=np.clip(g1, s.gamma_min, s.gamma_max), h=h1 - h1.min(), settings=s, extras=extras
-    )
     return Compensation(
         printed=printed,
         process=process,

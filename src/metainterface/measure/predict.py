@@ -165,19 +165,6 @@ def model_alpha(
     return alpha.numpy(), p_max.numpy()
 
 
-def curve_errors(
-    gamma: np.ndarray,
-    h: np.ndarray,
-    design: Design,
-    target: tuple[np.ndarray, np.ndarray],
-    model: Any = None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """(error (B,), coverage (B,)) of the cells (gamma, h) (B, N) by the forward model
-    against ``target``: the package's one grid curve error
-    (``physics.grid_error.grid_curve_error``) on this design's cell."""
-    return grid_curve_error(gamma, h, design.settings, target, model)
-
-
 def bem_error(p_star: np.ndarray, alpha: np.ndarray, target: tuple[np.ndarray, np.ndarray]):
     """The curve error of a BEM curve alpha (..., K) at its loads p_star (K,) against the
     target read at those loads (a BEM cell reaches every load: coverage 1)."""
@@ -335,15 +322,19 @@ def predict(
         np.stack([reg.gamma, design.gamma]), np.stack([reg.h, h_design]), design, p, model
     )
     alpha_fit, alpha_design = both
-    errs, cover = curve_errors(
-        np.stack([reg.gamma, design.gamma]), np.stack([reg.h, h_design]), design, target, model
+    errs, cover = grid_curve_error(
+        np.stack([reg.gamma, design.gamma]),
+        np.stack([reg.h, h_design]),
+        design.settings,
+        target,
+        model,
     )
     n = s.n_asperities
     g_alone = np.tile(design.gamma, (n, 1))
     h_alone = np.tile(h_design, (n, 1))
     g_alone[np.arange(n), np.arange(n)] = reg.gamma
     h_alone[np.arange(n), np.arange(n)] = reg.h
-    alone, _ = curve_errors(g_alone, h_alone, design, target, model)
+    alone, _ = grid_curve_error(g_alone, h_alone, design.settings, target, model)
     excess = np.maximum(alone - errs[1], 0.0)
     share = excess / excess.sum() if excess.sum() > 0 else np.zeros(n)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -13,8 +13,9 @@ from typing import Any
 import numpy as np
 
 from metainterface.measure.compensate import Compensation, compensate, process_from
-from metainterface.measure.predict import DISAGREE, RESOLVED_PIXELS, Prediction
+from metainterface.measure.predict import Prediction
 from metainterface.measure.register import Registration
+from metainterface.measure.report import measure_report, measure_warnings
 from metainterface.measure.scan import Scan
 from metainterface.physics.cell import Design
 
@@ -116,111 +117,12 @@ class MeasureResult:
 
     def warnings(self) -> list[str]:
         """Everything a user should know before trusting the figures, one line each."""
-        r, p = self.registration, self.prediction
-        sh = p.shapes
-        um = 1e6 * self.scan.radius_m
-        o = r.orientation
-        out = []
-        if o.ambiguous:
-            out.append(
-                f"orientation: {o.describe()} fits only {o.margin:.2g}x better than "
-                f"{o.runner_up}: too close to tell apart (the per-asperity figures may "
-                "belong to other asperities)"
-            )
-        if not 1 / 30 < o.height_scale < 30:
-            out.append(height_slip(o.height_scale))
-        if sh.terraces is not None:
-            t = sh.terraces
-            out.append(
-                f"terraces: layer steps of {t.step * um:.3g} um "
-                f"({'as given' if t.given else 'read from the scan'}); heights restored onto "
-                "them before the BEM"
-            )
-        flat = np.flatnonzero(sh.flat_radius > 0)
-        if flat.size:
-            radii = ", ".join(f"{k}: {sh.flat_radius[k] * um:.3g}" for k in flat)
-            out.append(f"flat tips (radius in um) on asperities {radii}; made flat before the BEM")
-        for k, what in enumerate(sh.feature):
-            if what:
-                out.append(f"asperity {k}: {what} (more than Delta_max/3 from its fitted shape)")
-        if sh.smoothed > 0:
-            out.append(
-                f"scan noise {sh.noise * um:.2g} um: the cell smoothed by a Gaussian of "
-                f"{sh.smoothed:.2g} grid steps"
-            )
-        if p.adhesion > 0:
-            out.append(
-                "adhesive part: the cell solved in the JKR-limit BEM by approach (its "
-                "contacts' resolution by the scan is not estimated)"
-            )
-        elif p.resolved_from is None:
-            out.append("the scan's pixels resolve the contacts at none of the loads")
-        elif p.resolved_from > p.p_star[0]:
-            out.append(
-                f"below P* = {p.resolved_from:.3g} the contacts are narrower than "
-                f"{RESOLVED_PIXELS:g} scan pixels: the prediction holds from there on"
-            )
-        if p.cell.filled > 0:
-            out.append(
-                f"{100 * p.cell.filled:.2g} % of the cell is not in the scan: filled with the "
-                "fitted asperities"
-            )
-        if np.any(p.disagree):
-            out.append(
-                "BEM on the measured cell and the fitted model differ by more than "
-                f"{100 * DISAGREE:g} % at P* = "
-                + ", ".join(f"{v:.3g}" for v in p.p_star[p.disagree])
-                + ": the made shapes are not all power laws (the BEM's figure is the one)"
-            )
-        return out
+        return measure_warnings(self)
 
     def report(self, max_error: float | None = None) -> str:
         """The summary a user reads on screen: the made error from BEM with its accuracy,
         the orientation found, the worst asperities in um, every warning, the correction."""
-        r, p, d = self.registration, self.prediction, self.design
-        um = 1e6 * self.scan.radius_m
-        lines = [
-            f"scan {self.scan.source}: {self.scan.shape[1]} x {self.scan.shape[0]} points, "
-            f"{self.scan.dx * um:.3g} um pixels; {int(r.seen.sum())} asperities fitted",
-            f"orientation: {r.orientation.describe()}, rotation "
-            f"{math.degrees(r.lattice.theta):.3g} deg (margin {r.orientation.margin:.2g}x over "
-            f"{r.orientation.runner_up})",
-            f"made error (BEM on the measured cell, {p.grid}^2, {len(p.p_star)} loads): "
-            f"{100 * p.error_bem:.3g} % +- {100 * p.error_accuracy:.2g} % (the BEM's own, "
-            f"from {p.grid_coarse}^2); fitted model {100 * p.error_fit:.3g} %, design "
-            f"{100 * p.error_design:.3g} %",
-        ]
-        h_design = d.h - d.h.min()
-        dev = (r.h - h_design) * um
-        worst = np.argsort(-p.share)[:3]
-        parts = [
-            f"{k} (gamma {d.gamma[k]:.3g} -> {r.gamma[k]:.3g}, h {dev[k]:+.3g} um, "
-            f"{100 * p.share[k]:.0f} % of the error)"
-            for k in worst
-            if p.share[k] > 0
-        ]
-        if parts:
-            lines.append("worst asperities: " + "; ".join(parts))
-        lines += [f"warning: {w}" for w in self.warnings()]
-        c = self.compensation
-        if c is not None:
-            if c.printed is None:
-                lines.append(
-                    f"correction: none written; the design printed as it is reads "
-                    f"{100 * c.error_before:.3g} % (BEM of the predicted made cell)"
-                )
-            else:
-                lines.append(
-                    f"correction: predicted made error {100 * c.error_before:.3g} % -> "
-                    f"{100 * c.error_after:.3g} % (BEM of the predicted made cell; the fitted "
-                    f"family alone would say {100 * c.error_family:.3g} %)"
-                )
-            lines += [f"correction cannot reach: {t}" for t in c.limits]
-        if max_error is not None and p.error_bem > max_error:
-            lines.append(
-                f"made error {100 * p.error_bem:.3g} % is above --max-error {100 * max_error:.3g} %"
-            )
-        return "\n".join(lines)
+        return measure_report(self, max_error)
 
     # --- reports -------------------------------------------------------------------------
 
@@ -472,16 +374,6 @@ def _array_hash(a: np.ndarray) -> str:
 
     digest = hashlib.sha256(np.ascontiguousarray(a, dtype=np.float64).tobytes()).hexdigest()
     return "sha256:" + digest[:16]
-
-
-def height_slip(scale: float) -> str:
-    """The warning for a scan whose heights are ``scale`` times the design's."""
-    factor = 10.0 ** (3 * round(math.log10(scale) / 3))
-    return (
-        f"the scan's heights are about {scale:.3g} times the design's: a height unit slip? "
-        f"(give the unit, e.g. --height-unit {'nm' if factor > 1 else 'mm'} where um was "
-        f"read; a factor {factor:g})"
-    )
 
 
 def _finite(value: float) -> float | None:

@@ -111,7 +111,7 @@ def measure(
         import warnings
 
         from metainterface.errors import UnitSlipWarning
-        from metainterface.measure.result import height_slip
+        from metainterface.measure.report import height_slip
 
         warnings.warn(height_slip(reg.orientation.height_scale), UnitSlipWarning, stacklevel=2)
     s = reg.scan  # as registered: mirrored where the file's y axis runs the other way
