@@ -44,13 +44,15 @@ def pytest_unconfigure(config: pytest.Config) -> None:
         shutil.rmtree(_WRITTEN.pop(), ignore_errors=True)
 
 
-#: Modules run first, longest first.
+#: Modules run first, longest first (in the long step, -m long, most of all).
 FIRST = (
     "tests/test_docs.py",
     "tests/scaling/test_adhesive_scale.py",
+    "tests/measure/test_printed.py",
+    "tests/units/test_friction_adhesion.py",
+    "tests/measure/test_predict.py",
     "tests/verify/test_verify.py",
     "tests/test_reproduce.py",
-    "tests/measure/test_predict.py",
     "tests/robustness/test_faults.py",
 )
 

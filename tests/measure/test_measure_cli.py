@@ -93,6 +93,7 @@ def test_unknown_format(files, capsys, tmp_path):
     assert "unknown scan format" in capsys.readouterr().err
 
 
+@pytest.mark.long
 def test_also_joins_more_scans_to_the_map(files, tmp_path):
     folder, width = files
     scan = str(folder / "scan.npy")

@@ -57,6 +57,7 @@ def compensation(measured):
     return measured.compensate()
 
 
+@pytest.mark.long
 def test_bem_of_the_scan_is_the_bem_of_the_made_cell(design, measured):
     p = measured.prediction
     m = p.cell.heights.shape[0]
@@ -69,6 +70,7 @@ def test_bem_of_the_scan_is_the_bem_of_the_made_cell(design, measured):
     assert p.cell.filled == 0.0
 
 
+@pytest.mark.long
 def test_made_error_is_the_made_cells(design, measured):
     # the error of the made part's closed-form model, against the design's target
     gamma, h = MADE.params(design)
@@ -81,6 +83,7 @@ def test_made_error_is_the_made_cells(design, measured):
     assert shares.sum() == pytest.approx(1.0)
 
 
+@pytest.mark.long
 def test_compensated_design_made_with_the_same_errors_meets_the_target(design, compensation):
     comp = compensation
     assert comp.pmap.gamma_shift == pytest.approx(0.15, abs=0.01)
@@ -94,6 +97,7 @@ def test_compensated_design_made_with_the_same_errors_meets_the_target(design, c
     assert comp.error_before > 0.05 and comp.error_after < 0.01
 
 
+@pytest.mark.long
 def test_files(design, measured, compensation, tmp_path):
     comp = compensation
     measured.write(tmp_path, compensate=comp)
@@ -139,11 +143,13 @@ def test_friction_needs_all_three(design):
         mi.measure(z * R, design, radius="0.5mm", pixel_size=dx * R, modulus="2MPa")
 
 
+@pytest.mark.long
 def test_compensated_design_exports_as_any_other(compensation, tmp_path):
     mi.export(compensation.printed, tmp_path / "next.npy", radius="0.5mm")
     assert np.isfinite(np.load(tmp_path / "next.npy")).all()
 
 
+@pytest.mark.long
 def test_map_from_two_scans(design, measured):
     # a second part of the same print, scanned elsewhere on the plate, less well
     z, dx = scan_of(design, MADE, cells=2, points=180, theta_deg=-1.0, noise=4e-4, seed=3)

@@ -56,6 +56,7 @@ def test_the_adhesive_envelope_holds_adhesive_cells_and_starts_above_zero():
     assert tiny[2] == pytest.approx(plain[2], rel=1e-4)
 
 
+@pytest.mark.long
 def test_feasible_scale_takes_the_work_of_adhesion(law_csv):
     """The offset law is refused without w, and with it reachable at its own area and out
     of reach at a quarter of it, with advice in friction terms, w named."""

@@ -165,6 +165,7 @@ def test_offset_law_designed_within_two_percent(tmp_path):
     assert f0 == pytest.approx(ff[0], rel=0.01)
 
 
+@pytest.mark.long
 def test_an_extrapolated_offset_gets_no_offset_polish(tmp_path):
     """The F_0 polish is for laws that give their friction at zero load: a law from a
     positive load has its F_0 extrapolated from its first two rows, which the notes say, and

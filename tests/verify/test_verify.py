@@ -147,6 +147,7 @@ def test_each_iteration_says_where_its_design_came_from(corrected):
     assert r.corrections[0].to_dict()["start"] == "current"
 
 
+@pytest.mark.long
 def test_a_fresh_design_meets_a_realisable_shifted_target(unchecked):
     # realisable: a design's own curve on the correction's default model (the module's
     # bilinear design, not one made for this test)
