@@ -5,8 +5,10 @@ and each target's BEM error. Compare two source trees by running it on each in t
 (``PYTHONPATH=<tree>/src``), alternately.
 
     PYTHONPATH=src python benchmarks/bench_correction_cost.py [--targets 5] [--grid 384]
+        [--iterations 3]
 
-``--grid``: the check's grid (default: the check's own, 384^2 for N = 9).
+``--grid``: the check's grid (default: the check's own, 384^2 for N = 9); ``--iterations``:
+the correction's most BEM solves (default: the check's own, 3).
 """
 
 from __future__ import annotations
@@ -31,16 +33,17 @@ def cpu() -> float:
 
 
 # Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
-QUICK = "--targets 1 --grid 96"
+QUICK = "--targets 1 --grid 96 --iterations 1"
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--targets", type=int, default=5)
     ap.add_argument("--grid", type=int, default=None, help="the check's grid")
+    ap.add_argument("--iterations", type=int, default=3, help="the correction's most solves")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
-    verify = mi.Verify(grid=args.grid)
+    verify = mi.Verify(grid=args.grid, iterations=args.iterations)
     mi.design("saturating", verify=verify)  # warm-up: the networks, the envelope, the workers
     targets = realisable_targets(args.targets, seed=11)
     c0, w0 = cpu(), time.perf_counter()
