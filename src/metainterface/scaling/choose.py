@@ -323,12 +323,16 @@ class _AtScale:
     def adhesive(self) -> bool:
         return bool(self.given["work_of_adhesion"])
 
+    def scale(self, value: float) -> dict[str, Any]:
+        """The scale with ``var`` = ``value``, the others as given (SI)."""
+        return {**self.given, self.var: float(value)}
+
     def target(self, value: float, label: str) -> Target:
         """The law as a target with ``var`` = ``value`` (the work of adhesion as w / (E* R)
         at that scale, in its meta)."""
         from metainterface.units.friction import fit_record, friction_target
 
-        at = {**self.given, self.var: float(value)}
+        at = self.scale(value)
         ft = friction_target(
             self.law,
             shear_strength=at["shear_strength"],
@@ -349,7 +353,7 @@ class _AtScale:
 
     def size(self, size: dict[str, Any], value: float, fs: _scale.FeasibleScale) -> dict:
         """The design's physical size options at ``value`` (the target carries w)."""
-        at = {**self.given, self.var: value}
+        at = self.scale(value)
         out = {**size, "modulus": at["modulus"], "radius": at["radius"], "work_of_adhesion": None}
         if out["total_force"] is None:
             out["area"] = at["area"]
@@ -359,7 +363,7 @@ class _AtScale:
 def _quick_effort(knobs: dict[str, Any], adhesive: bool) -> Effort:
     """The candidates' quick design: a short refinement (``QUICK``), no fallback; an offset
     law's F_0 polished in it too."""
-    effort = Effort(
+    return Effort(
         hedge=knobs["hedge"],
         seed=knobs["seed"],
         surrogate=knobs["surrogate"],
@@ -369,7 +373,6 @@ def _quick_effort(knobs: dict[str, Any], adhesive: bool) -> Effort:
         # with its prediction in one batch, not after it
         hedge_error=0.0,
     )
-    return effort
 
 
 def _full_design(
@@ -384,7 +387,7 @@ def _full_design(
     target's meta ("scale")."""
     from metainterface.designer.run import design
 
-    n_cells, per_side = fs.tiles({**at.given, at.var: value}["area"])
+    n_cells, per_side = fs.tiles(at.scale(value)["area"])
     t = at.target(value, stem)
     record = {"variable": at.var, "value": value, "searched": list(fs.bounds[at.var])}
     record.update(scores, n_cells=n_cells, tiles_per_side=per_side)

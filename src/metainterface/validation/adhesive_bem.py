@@ -38,11 +38,11 @@ the two rules until it no longer changes, and the state returned has its displac
 hold a point of C only, and the preconditioner's in float32 (the residual the solve is
 held to is float64's): the benchmark check (``benchmarks/bench_adhesive_bound.py``) went
 from 157 s to 16-18 s beside other work (load ~3-4) with the same contact fractions
-(benchmarks/results/adhesion.md). c_e
-(``EDGE_FACTOR``) is calibrated for this kernel on a flat punch (it comes off at Kendall's
-F = sqrt(8 pi w E* a^3)), see ``pull_off_factor``, and c_g follows from the crack's
-opening; the JKR sphere is then an independent check: a Hertz asperity's contact fraction
-against the JKR a(P) at each compressive force, loading and unloading, falls with the grid
+(benchmarks/results/adhesion.md). c_e (``EDGE_FACTOR``) is calibrated for this kernel on a
+flat punch (it comes off at Kendall's F = sqrt(8 pi w E* a^3)), see
+``adhesive_edge.pull_off_factor``, and c_g follows from the crack's opening; the JKR sphere
+is then an independent check: a Hertz asperity's contact fraction against the JKR a(P) at
+each compressive force, loading and unloading, falls with the grid
 (the edge is placed to a fraction of a spacing; benchmarks/results/adhesion.md).
 
 Everything is float64 (but the JKR preconditioner, above) and batched over a leading axis
@@ -63,11 +63,12 @@ from metainterface.validation.torch_bem import displacement, unit_kernel
 
 #: The edge-element factor c_e of the JKR (Pohrt-Popov) criterion for this kernel: a bonded
 #: flat punch pulled through ``solve_jkr`` comes off at Kendall's force with it
-#: (``pull_off_factor``: 1.016-1.027, mean 1.021, over six sub-pixel radii a / dx = 20-32 at
-#: 256^2, the resolution of a check; it rises slowly with a / dx, 1.006 at 6-12, 1.011 at
-#: 10-25). It was 1.035, the most tensile point of the untrimmed disc (``edge_factor``): the
-#: first point to come off, after which the trimmed edge holds a few % more, so a receding
-#: edge lagged (a Hertz asperity's unloading read +3.35 % at 256^2).
+#: (``adhesive_edge.pull_off_factor``: 1.016-1.027, mean 1.021, over six sub-pixel radii
+#: a / dx = 20-32 at 256^2, the resolution of a check; it rises slowly with a / dx, 1.006 at
+#: 6-12, 1.011 at 10-25). It was 1.035, the most tensile point of the untrimmed disc
+#: (``adhesive_edge.edge_factor``): the first point to come off, after which the trimmed edge
+#: holds a few % more, so a receding edge lagged (a Hertz asperity's unloading read +3.35 %
+#: at 256^2).
 EDGE_FACTOR = 1.021
 #: The closing factor c_g, from the JKR crack's opening: at a sharp edge of stress intensity K
 #: the gap a distance s outside it is sqrt(8 / pi) K sqrt(s) / E* (Kendall's flat punch,
@@ -410,64 +411,6 @@ def solve_jkr(
     p_star = p.mean(dim=(1, 2))
     alpha = contact.to(z.dtype).mean(dim=(1, 2))
     return AdhesiveSolution(p, g, contact, p_star, alpha, res, 0)
-
-
-def edge_factor(grid: int = 256, radius_cells: float = 0.125) -> float:
-    """The first point to come off: a bonded flat punch of radius a = radius_cells L on a
-    grid of M points, its most tensile edge point against K_I = F / (2 sqrt(pi a^3))
-    (Kendall), a from the punch's pixel count. Returns max |p_edge| sqrt(dx) / K_I: 1.02-1.06,
-    mean 1.036, over 13 radii at 256^2, above ``EDGE_FACTOR`` since the trimmed edge holds
-    more than the untrimmed disc's most tensile point (``pull_off_factor``)."""
-    side = 1.0
-    dx = side / grid
-    x = (np.arange(grid) - grid / 2) * dx
-    r = np.hypot(*np.meshgrid(x, x, indexing="ij"))
-    disc = r < radius_cells * side
-    heights = torch.as_tensor(np.where(disc, 0.0, -1.0))[None]
-    contact = torch.as_tensor(disc)[None]
-    fwd = forward_kernel(grid, side, torch.device("cpu"))
-    c = torch.full((1, 1, 1), -1e-3, dtype=torch.float64)  # a pull of 1e-3 L
-    p, _ = _bonded(heights, c, contact, fwd, torch.zeros_like(heights), 1e-12, 10000)
-    force = float(p.sum()) * dx * dx
-    a = math.sqrt(disc.sum() * dx * dx / math.pi)
-    k_i = abs(force) / (2.0 * math.sqrt(math.pi * a**3))
-    return float(p.abs().amax()) * math.sqrt(dx) / k_i
-
-
-def pull_off_factor(grid: int = 128, radius_cells: float = 0.1, step: float = 0.002) -> float:
-    """Calibrate c_e on the observable: a flat punch of radius a = radius_cells L (a disc of
-    grid points), bonded, pulled off through ``solve_jkr`` itself with c_e = 1 in steps of
-    ``step`` of the pull at which Kendall's K_I = F / (2 sqrt(pi a^3)) reaches K_c. Its
-    points come off one by one (the most tensile first, the edge trimmed) until the punch
-    lets go; the largest K_I of a stable state, a from its own pixel count, is c_e = 1's
-    detachment K. The thresholds scale with c_e, so c_e = K_c / that K makes the punch come
-    off at Kendall's force. Returns it."""
-    side, work = 1.0, 1e-4
-    dx = side / grid
-    x = (np.arange(grid) - grid / 2) * dx
-    disc = np.hypot(*np.meshgrid(x, x, indexing="ij")) < radius_cells * side
-    z = torch.as_tensor(np.where(disc, 0.0, -1.0))[None]
-    contact = torch.as_tensor(disc)[None]
-    k_c = math.sqrt(2.0 * work)
-
-    def k_of(p: Tensor, n: float) -> float:
-        a = math.sqrt(n * dx * dx / math.pi)
-        return abs(float(p.sum())) * dx * dx / (2.0 * math.sqrt(math.pi * a**3))
-
-    fwd = forward_kernel(grid, side, z.device)
-    unit, _ = _bonded(z, -torch.ones(1, 1, 1, dtype=z.dtype), contact, fwd, z * 0, 1e-12, 10000)
-    pull = k_c / k_of(unit, disc.sum())  # the pull at which the bonded punch has K_c
-    z_bar = -float(z.mean())
-    n0, k_max, pressure = float(disc.sum()), 0.0, None
-    for s in np.arange(0.8, 1.3, step):
-        target = torch.tensor([z_bar + s * pull], dtype=z.dtype)
-        sol = solve_jkr(z, side, target, work, contact=contact, pressure=pressure, edge=1.0)
-        contact, pressure = sol.contact, sol.pressure
-        n = float(contact.sum())
-        if n < 0.5 * n0:
-            break
-        k_max = max(k_max, k_of(pressure, n))
-    return k_c / k_max
 
 
 @dataclass(frozen=True)
