@@ -22,7 +22,7 @@ import torch
 
 import metainterface as mi
 from metainterface.physics import CellSettings, Design
-from metainterface.validation.adhesive_bem import jkr_path
+from metainterface.validation.adhesive_path import jkr_path
 from metainterface.validation.heightmap import height_map
 
 W = 4.2e-5

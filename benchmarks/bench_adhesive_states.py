@@ -19,7 +19,7 @@ import torch
 
 import metainterface as mi
 from metainterface.physics import CellSettings, Design
-from metainterface.validation.adhesive_bem import jkr_path
+from metainterface.validation.adhesive_path import jkr_path
 from metainterface.validation.heightmap import height_map
 from metainterface.verify.adhesive import APPROACHES_PER_LOAD, approaches, clear_of_snap_ins
 

@@ -11,6 +11,7 @@ import torch
 from metainterface.physics import CellSettings, Design
 from metainterface.validation import adhesive_bem as ab
 from metainterface.validation import adhesive_edge as edge
+from metainterface.validation.adhesive_path import jkr_path
 from metainterface.validation.heightmap import height_map
 
 F64 = torch.float64
@@ -108,7 +109,7 @@ def _hertz_asperity_errors(grid, w=4.2e-5):
     design = Design(gamma=np.array([2.0]), h=np.array([0.0]), settings=CellSettings(n_asperities=1))
     hm = height_map(design, grid)
     side = hm.cell_side
-    path = ab.jkr_path(
+    path = jkr_path(
         hm.heights, side, w, np.linspace(0, 0.02, 9)[1:], unload=np.linspace(0.02, 0.002, 7)[1:]
     )
     force = path.p_star * side**2

@@ -292,7 +292,7 @@ def predict(
     load of either grid; engine, device: the BEM's (``solve_path``); z_step: the printer's
     layer step [R] where known (else read from the scan). adhesion: the work of adhesion
     [E* R] of an adhesive part: the cell is then solved in the JKR-limit BEM by approach,
-    its loading curve the states a rising force reaches (``adhesive_bem.jkr_path``), and
+    its loading curve the states a rising force reaches (``adhesive_path.jkr_path``), and
     the fitted model is the adhesive one."""
     s = design.settings
     if adhesion > 0:
@@ -403,7 +403,7 @@ def adhesive_alpha(
     the JKR-limit BEM by approach up to ``depth`` [R], the states on the rising-force branch,
     read at the loads (held beyond them). adhesion: w [E* R]."""
     from metainterface._device import resolve_device
-    from metainterface.validation.adhesive_bem import jkr_path
+    from metainterface.validation.adhesive_path import jkr_path
 
     s = design.settings
     k = APPROACHES_PER_LOAD * len(p_star)

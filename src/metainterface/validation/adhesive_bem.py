@@ -19,31 +19,29 @@ several grid points this is the Tabor-regime contact (JKR when rho is small agai
 contact, DMT when large): checked against Tamaas's ``MaugisAdhesionFunctional``.
 
 JKR, the range unresolved (Pohrt & Popov, Facta Univ. Mech. Eng. 13, 2015, 3-10). At a
-sharp (JKR) edge the tension is -K_I / sqrt(2 pi s) at distance s from it, with
-K_I = sqrt(2 E* w) when the energy released equals w. A grid of spacing dx cannot follow
-that; the stress of the edge element is instead c_e K_I / sqrt(dx), c_e a constant of
-the discretisation. The mesh-dependent criterion: a point in contact comes off where its
+sharp (JKR) edge the tension is -K_I / sqrt(2 pi s) at distance s from it, with K_I =
+sqrt(2 E* w) when the energy released equals w. A grid of spacing dx cannot follow that;
+the stress of the edge element is instead c_e K_I / sqrt(dx), c_e a constant of the
+discretisation. The mesh-dependent criterion: a point in contact comes off where its
 tension exceeds sigma_c = c_e sqrt(2 E* w / dx), and a point comes into contact where the
 surfaces overlap, or, beside the contact, where the gap is below the opening of a critical
-crack half a spacing behind its edge, c_g sqrt(2 E* w dx) / E*, c_g = 2 / sqrt(pi) from
-the crack's opening profile (so the edge sits where the energy released equals w on
-loading too: the reversible JKR branch that the forward model follows; a point that came
-off in a solve closes again only by overlap, so the updates cannot cycle). At each mean
-gap the bonded problem (g = 0 on the contact set C, p = 0 off it) is linear and solved by
-conjugate gradients on the points of C, preconditioned with the half-space's stiffness
-E* |q| / 2 kept to C (as ``torch_bem``; about 13 iterations a solve on a 9-asperity cell
-instead of 45-62), each set warm-started from the last set's pressures; C is updated by
-the two rules until it no longer changes, and the state returned has its displacement
-(and so its residual) computed afresh. The transforms along the rows run on the rows that
-hold a point of C only, and the preconditioner's in float32 (the residual the solve is
-held to is float64's): the benchmark check (``benchmarks/bench_adhesive_bound.py``) went
-from 157 s to 16-18 s beside other work (load ~3-4) with the same contact fractions
-(benchmarks/results/adhesion.md). c_e (``EDGE_FACTOR``) is calibrated for this kernel on a
+crack half a spacing behind its edge, c_g sqrt(2 E* w dx) / E*, c_g = 2 / sqrt(pi) from the
+crack's opening profile (so the edge sits where the energy released equals w on loading
+too: the reversible JKR branch that the forward model follows; a point that came off in a
+solve closes again only by overlap, so the updates cannot cycle). At each mean gap the
+bonded problem (g = 0 on the contact set C, p = 0 off it) is linear and solved by conjugate
+gradients on the points of C, preconditioned with the half-space's stiffness E* |q| / 2
+kept to C (as ``torch_bem``), each set warm-started from the last set's pressures; C is
+updated by the two rules until it no longer changes, and the state returned has its
+displacement (and so its residual) computed afresh. The transforms along the rows run on
+the rows that hold a point of C only, and the preconditioner's in float32 (the residual the
+solve is held to is float64's; ``benchmarks/bench_adhesive_bound.py`` measures the cost, in
+benchmarks/results/adhesion.md). c_e (``EDGE_FACTOR``) is calibrated for this kernel on a
 flat punch (it comes off at Kendall's F = sqrt(8 pi w E* a^3)), see
 ``adhesive_edge.pull_off_factor``, and c_g follows from the crack's opening; the JKR sphere
 is then an independent check: a Hertz asperity's contact fraction against the JKR a(P) at
-each compressive force, loading and unloading, falls with the grid
-(the edge is placed to a fraction of a spacing; benchmarks/results/adhesion.md).
+each compressive force, loading and unloading, falls with the grid (the edge is placed to a
+fraction of a spacing; benchmarks/results/adhesion.md).
 
 Everything is float64 (but the JKR preconditioner, above) and batched over a leading axis
 B of cells of one grid size and side (``heights`` (B, M, M)); no loops over grid points.
@@ -54,7 +52,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
 import torch
 from torch import Tensor
 
@@ -411,89 +408,3 @@ def solve_jkr(
     p_star = p.mean(dim=(1, 2))
     alpha = contact.to(z.dtype).mean(dim=(1, 2))
     return AdhesiveSolution(p, g, contact, p_star, alpha, res, 0)
-
-
-@dataclass(frozen=True)
-class AdhesivePath:
-    """A cell loaded by approach (displacement control) in the JKR limit, then unloaded.
-
-    approach: (K,) the approach of the rigid plane [length, units of R] (0: the mean gap
-    of the surface's own tips-down plane); p_star, alpha: (K,) the BEM's mean pressure and
-    contact fraction there; loading: (K,) bool, the samples of the rising part; on_branch:
-    (K,) bool, the loading samples a rising force reaches (force at its running maximum
-    and > 0: the states of the load-controlled curve the forward model gives, as far as the
-    samples tell: a peak between two samples is not seen); touching: (K, N) bool, which
-    asperities have a point in contact (with ``owner``, else None); asperity_alpha: (K, N)
-    each asperity's contact area over the cell's (with ``owner``); p_max: (K,) the largest
-    local pressure [E*]; residual: (K,) the bonded solve's relative residual; seconds: (K,)
-    wall time of each state; pressure: (M, M) the last state's pressure [E*].
-    """
-
-    approach: np.ndarray
-    p_star: np.ndarray
-    alpha: np.ndarray
-    loading: np.ndarray
-    on_branch: np.ndarray
-    touching: np.ndarray | None = None
-    asperity_alpha: np.ndarray | None = None
-    p_max: np.ndarray | None = None
-    residual: np.ndarray | None = None
-    seconds: np.ndarray | None = None
-    pressure: np.ndarray | None = None
-
-
-def jkr_path(
-    heights: np.ndarray,
-    side: float,
-    work: float,
-    approaches: np.ndarray,
-    *,
-    unload: np.ndarray | None = None,
-    device: torch.device | str = "cpu",
-    owner: np.ndarray | None = None,
-) -> AdhesivePath:
-    """One cell (M, M) along rising ``approaches`` (K,) [length], then falling ``unload``
-    ones, each state warm-started from the one before (the contact's history matters).
-    ``owner``: (M, M) the asperity index of each point (``heightmap.owner_map``), for the
-    path's ``touching``."""
-    z = torch.as_tensor(np.ascontiguousarray(heights, dtype=np.float64), device=device)[None]
-    z_bar = -float(z.mean())
-    up = np.asarray(approaches, dtype=np.float64)
-    down = np.zeros(0) if unload is None else np.asarray(unload, dtype=np.float64)
-    import time
-
-    contact = pressure = None
-    p_star, alpha, touching, share, p_max, residual, seconds = [], [], [], [], [], [], []
-    n_owner = 0 if owner is None else int(owner.max()) + 1
-    own = None if owner is None else torch.as_tensor(owner, device=z.device).reshape(-1)
-    for d in np.concatenate([up, down]):
-        start = time.perf_counter()
-        target = torch.tensor([z_bar - d], dtype=torch.float64, device=z.device)
-        sol = solve_jkr(z, side, target, work, contact=contact, pressure=pressure)
-        contact, pressure = sol.contact, sol.pressure
-        p_star.append(float(sol.p_star[0]))
-        alpha.append(float(sol.alpha[0]))
-        p_max.append(float(sol.pressure[0].amax()))
-        residual.append(float(sol.residual[0]))
-        if own is not None:
-            hits = torch.bincount(own[sol.contact[0].reshape(-1)], minlength=n_owner)
-            touching.append((hits > 0).cpu().numpy())
-            share.append((hits / own.numel()).cpu().numpy())
-        seconds.append(time.perf_counter() - start)
-    p = np.array(p_star)
-    loading = np.arange(p.size) < up.size
-    top = np.maximum.accumulate(np.where(loading, p, -np.inf))
-    on_branch = loading & (p >= top) & (p > 0)
-    return AdhesivePath(
-        np.concatenate([up, down]),
-        p,
-        np.array(alpha),
-        loading,
-        on_branch,
-        np.array(touching) if own is not None else None,
-        np.array(share) if own is not None else None,
-        np.array(p_max),
-        np.array(residual),
-        np.array(seconds),
-        None if pressure is None else pressure[0].cpu().numpy(),
-    )

@@ -3,16 +3,18 @@
 A design made with an adhesive model has the loading curve under load control: the normal
 force rises from zero, each asperity snaps in when it touches and the cell follows the
 running maximum of its force (``physics.adhesion``). The BEM (``adhesive_bem``) solves the
-cell by approach (displacement control: an adhesive contact has unstable branches that
-load control would jump), at K approaches from touch up to a step past where the model
-reaches the top load. The states a rising force reaches, those whose force is at its
-running maximum and positive and clear of the model's snap-ins (``clear_of_snap_ins``),
-are the BEM's load-controlled curve. Both design's check (``verify.adhesive``) and
-``validate`` of an adhesive design (``adhesive_validate``) read it.
+cell by approach (displacement control: an adhesive contact has unstable branches that load
+control would jump), at K approaches from touch up to a step past where the model reaches
+the top load (``jkr_path``, each state warm-started from the one before). The states a
+rising force reaches, those whose force is at its running maximum and positive and clear of
+the model's snap-ins (``clear_of_snap_ins``), are the BEM's load-controlled curve. Both
+design's check (``verify.adhesive``) and ``validate`` of an adhesive design
+(``adhesive_validate``) read it.
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,7 +23,92 @@ import torch
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
-from metainterface.validation.adhesive_bem import AdhesivePath
+from metainterface.validation.adhesive_bem import solve_jkr
+
+
+@dataclass(frozen=True)
+class AdhesivePath:
+    """A cell loaded by approach (displacement control) in the JKR limit, then unloaded.
+
+    approach: (K,) the approach of the rigid plane [length, units of R] (0: the mean gap
+    of the surface's own tips-down plane); p_star, alpha: (K,) the BEM's mean pressure and
+    contact fraction there; loading: (K,) bool, the samples of the rising part; on_branch:
+    (K,) bool, the loading samples a rising force reaches (force at its running maximum
+    and > 0: the states of the load-controlled curve the forward model gives, as far as the
+    samples tell: a peak between two samples is not seen); touching: (K, N) bool, which
+    asperities have a point in contact (with ``owner``, else None); asperity_alpha: (K, N)
+    each asperity's contact area over the cell's (with ``owner``); p_max: (K,) the largest
+    local pressure [E*]; residual: (K,) the bonded solve's relative residual; seconds: (K,)
+    wall time of each state; pressure: (M, M) the last state's pressure [E*].
+    """
+
+    approach: np.ndarray
+    p_star: np.ndarray
+    alpha: np.ndarray
+    loading: np.ndarray
+    on_branch: np.ndarray
+    touching: np.ndarray | None = None
+    asperity_alpha: np.ndarray | None = None
+    p_max: np.ndarray | None = None
+    residual: np.ndarray | None = None
+    seconds: np.ndarray | None = None
+    pressure: np.ndarray | None = None
+
+
+def jkr_path(
+    heights: np.ndarray,
+    side: float,
+    work: float,
+    approaches: np.ndarray,
+    *,
+    unload: np.ndarray | None = None,
+    device: torch.device | str = "cpu",
+    owner: np.ndarray | None = None,
+) -> AdhesivePath:
+    """One cell (M, M) along rising ``approaches`` (K,) [length], then falling ``unload``
+    ones, each state warm-started from the one before (the contact's history matters).
+    ``owner``: (M, M) the asperity index of each point (``heightmap.owner_map``), for the
+    path's ``touching``."""
+    z = torch.as_tensor(np.ascontiguousarray(heights, dtype=np.float64), device=device)[None]
+    z_bar = -float(z.mean())
+    up = np.asarray(approaches, dtype=np.float64)
+    down = np.zeros(0) if unload is None else np.asarray(unload, dtype=np.float64)
+    contact = pressure = None
+    p_star, alpha, touching, share, p_max, residual, seconds = [], [], [], [], [], [], []
+    n_owner = 0 if owner is None else int(owner.max()) + 1
+    own = None if owner is None else torch.as_tensor(owner, device=z.device).reshape(-1)
+    for d in np.concatenate([up, down]):
+        start = time.perf_counter()
+        target = torch.tensor([z_bar - d], dtype=torch.float64, device=z.device)
+        sol = solve_jkr(z, side, target, work, contact=contact, pressure=pressure)
+        contact, pressure = sol.contact, sol.pressure
+        p_star.append(float(sol.p_star[0]))
+        alpha.append(float(sol.alpha[0]))
+        p_max.append(float(sol.pressure[0].amax()))
+        residual.append(float(sol.residual[0]))
+        if own is not None:
+            hits = torch.bincount(own[sol.contact[0].reshape(-1)], minlength=n_owner)
+            touching.append((hits > 0).cpu().numpy())
+            share.append((hits / own.numel()).cpu().numpy())
+        seconds.append(time.perf_counter() - start)
+    p = np.array(p_star)
+    loading = np.arange(p.size) < up.size
+    top = np.maximum.accumulate(np.where(loading, p, -np.inf))
+    on_branch = loading & (p >= top) & (p > 0)
+    return AdhesivePath(
+        np.concatenate([up, down]),
+        p,
+        np.array(alpha),
+        loading,
+        on_branch,
+        np.array(touching) if own is not None else None,
+        np.array(share) if own is not None else None,
+        np.array(p_max),
+        np.array(residual),
+        np.array(seconds),
+        None if pressure is None else pressure[0].cpu().numpy(),
+    )
+
 
 #: Approaches of the path per load asked for: some states of the path are not on the
 #: rising-force branch (just after a snap-in the force dips below its running maximum), so
@@ -71,7 +158,7 @@ def clear_of_snap_ins(p_star: np.ndarray, touching: np.ndarray, peaks: np.ndarra
 class RisingBranch:
     """The adhesive BEM's path of a cell and which of its states a rising force reaches.
 
-    path: the BEM's states by approach (``adhesive_bem.AdhesivePath``); keep: (K,) bool,
+    path: the BEM's states by approach (``AdhesivePath``); keep: (K,) bool,
     the states on the rising-force branch clear of snap-ins and at most ``top`` (the load
     asked up to); approaches: (K,) [length]; device: where it solved; seconds: wall time.
     """
@@ -97,7 +184,6 @@ def rising_branch(
     import time
 
     from metainterface._device import resolve_device
-    from metainterface.validation.adhesive_bem import jkr_path
     from metainterface.validation.heightmap import height_map
 
     if not model.adhesion:
