@@ -112,17 +112,26 @@ def fit_lattice(
     *,
     tied: bool = False,
     rounds: int = 2,
+    height_scale: float = 1.0,
 ) -> LatticeFit:
     """Stage 1 (module docstring) from first estimates: ``start`` lattice, tilt (2,), and
     per-asperity tip heights z0 (N,) [R] and exponents (N,) (from a first stage 2).
 
     tied: the tip heights follow the design's, z0_k = z_c - a h_k (a height scale a), for
     scans that show each asperity in one cell only: there a free z0_k per asperity would
-    take up the tilt."""
+    take up the tilt.
+
+    height_scale: the scan's heights over the design's (``Orientation.height_scale``): a
+    scan in the wrong height unit (a factor 1000) is fitted at the design's scale, for its
+    slip to be reported rather than the fit to diverge; tilt, tips and rms come back in the
+    scan's own heights."""
     s = design.settings
     n, pitch0 = s.n_side, start.design_pitch
     zs = s.delta_max  # height scale of the unknowns
+    hs = height_scale if height_scale > 0 else 1.0
     x_np, y_np, z_np = _grid_points(scan, LATTICE_POINTS)
+    z_np = z_np / hs
+    tilt0, z0_start = np.asarray(tilt0) / hs, np.asarray(z0_start) / hs
     x, y, z = (torch.as_tensor(a) for a in (x_np, y_np, z_np))
     # unknowns, each of order one: origin / pitch, angle, log scale, tilt * pitch / zs, ...
     o = torch.tensor(start.origin / pitch0, requires_grad=True)
@@ -169,7 +178,7 @@ def fit_lattice(
             model = model + (tilt[0] * xs + tilt[1] * ys) * zs / pitch0
             return ((zk - model) ** 2).mean() / zs**2
 
-        _lbfgs([o, th, ls, tilt, z0 if not tied else scale, g, zc], loss_fn, iters=100)
+        _lbfgs([o, th, ls, tilt, z0 if not tied else scale, g, zc], loss_fn, iters=300)
         rms = float(loss_fn().detach().sqrt()) * zs
     with torch.no_grad():
         lat = Lattice(
@@ -180,10 +189,10 @@ def fit_lattice(
         )
         return LatticeFit(
             lattice=lat,
-            tilt=tilt.numpy() * zs / pitch0,
-            z0=(tips() + zc).numpy() * zs,
+            tilt=tilt.numpy() * zs * hs / pitch0,
+            z0=(tips() + zc).numpy() * zs * hs,
             gamma=g.clamp(*GAMMA_RANGE).numpy().copy(),
-            rms=rms,
+            rms=rms * hs,
         )
 
 

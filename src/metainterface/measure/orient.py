@@ -37,6 +37,9 @@ from metainterface.physics.cell import Design
 MIN_MARGIN = 2.0
 #: Floor of a score (a perfect, noiseless match would divide by zero in the margin).
 SCORE_FLOOR = 1e-6
+#: A height scale beyond this factor either way is a unit slip, not a part made too tall
+#: or too flat (a print's heights are off by tens of percent; a unit by 1000).
+SLIP_FACTOR = 30.0
 
 
 @dataclass(frozen=True)
@@ -61,6 +64,11 @@ class Orientation:
     runner_up: str
     ambiguous: bool
     height_scale: float = 1.0
+
+    @property
+    def unit_slip(self) -> bool:
+        """Whether ``height_scale`` is off by more than ``SLIP_FACTOR`` either way."""
+        return not 1 / SLIP_FACTOR < self.height_scale < SLIP_FACTOR
 
     def describe(self) -> str:
         """The orientation in words, e.g. 'turned 90 degrees, mirrored (y reversed)'."""

@@ -86,7 +86,16 @@ def register(scan: Scan, design: Design) -> Registration:
         # a scan of part of a cell levels slowly (tilt, shapes and heights trade off over few
         # asperities); it is small, so more rounds cost little
         refined = fit_lattice(
-            scan, design, lattice, tilt, z0, gamma, tied=tied, rounds=TIED_ROUNDS if tied else 2
+            scan,
+            design,
+            lattice,
+            tilt,
+            z0,
+            gamma,
+            tied=tied,
+            rounds=TIED_ROUNDS if tied else 2,
+            # a unit slip's heights are 1000 times the design's: its unknowns scaled to match
+            height_scale=orientation.height_scale if orientation.unit_slip else 1.0,
         )
         lattice, tilt = refined.lattice, refined.tilt
         # the final fit leaves each top's noise band out: a flat tip's plateau is no power

@@ -25,7 +25,7 @@ def measure_warnings(result: Any) -> list[str]:
             f"{o.runner_up}: too close to tell apart (the per-asperity figures may "
             "belong to other asperities)"
         )
-    if not 1 / 30 < o.height_scale < 30:
+    if o.unit_slip:
         out.append(height_slip(o.height_scale))
     if sh.terraces is not None:
         t = sh.terraces

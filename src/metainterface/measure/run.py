@@ -107,7 +107,7 @@ def measure(
 
         grid = check_grid(grid, design.settings)
     reg = register(s, design)
-    if not 1 / 30 < reg.orientation.height_scale < 30:
+    if reg.orientation.unit_slip:
         import warnings
 
         from metainterface.errors import UnitSlipWarning
