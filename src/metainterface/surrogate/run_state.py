@@ -95,6 +95,9 @@ def resume(
     torch.set_rng_state(state["rng"])
     if dev.type == "cuda" and "cuda_rng" in state:  # dropout draws there on CUDA
         torch.cuda.set_rng_state(state["cuda_rng"], dev)
+    # a kill between the epoch's two renames leaves metrics.csv an epoch behind: the
+    # checkpoint's history is the record
+    write_metrics(ckpt_path.parent / "metrics.csv", state["history"])
     return RunState(
         state["epoch"], state["best"], state["best_epoch"], state["bad"], state["history"]
     )
