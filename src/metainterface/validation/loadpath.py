@@ -198,12 +198,7 @@ def tamaas_path(
     total = len(loads) if total is None else total
     surface = np.ascontiguousarray(heights, dtype=np.float64)  # Tamaas keeps a reference
     m = surface.shape[0]
-    k = len(loads)
-    alpha, alpha_pixels, p_max, residual, seconds = (np.empty(k) for _ in range(5))
-    per = np.empty((k, n_asperities))
-    owner_flat = np.asarray(owner).ravel()
-    pressures = np.empty((k, m, m)) if fields else None
-    gaps = np.empty((k, m, m)) if fields else None
+    rec = PathRecorder(len(loads), m, owner, n_asperities, fields)
     with _quiet(tm):
         model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [float(cell_side)] * 2, [m, m])
         model.E, model.nu = 1.0, 0.0  # E* = E / (1 - nu^2) = 1
@@ -220,22 +215,17 @@ def tamaas_path(
                     f"BEM failed at load {first_index + i + 1} of {total} (P* = {p:.6g}): "
                     f"{str(exc).strip().splitlines()[-1]} (try a finer grid)"
                 ) from None
-            seconds[i] = time.perf_counter() - start
+            sec = time.perf_counter() - start
             if not err <= tolerance:
                 raise MetainterfaceError(
                     f"BEM did not converge at load {first_index + i + 1} of {total} "
                     f"(P* = {p:.6g}): residual {err:.3g} > tolerance {tolerance:g} "
                     f"after {max_iter} iterations"
                 )
-            traction = model.traction.reshape(m, m)
-            alpha[i], per[i], alpha_pixels[i] = contact_area(traction, owner_flat, n_asperities)
-            p_max[i] = float(traction.max())
-            residual[i] = err
-            if pressures is not None and gaps is not None:
-                pressures[i] = traction
-                # Tamaas's displacement equals the surface where in contact: gap = u - z >= 0
-                gaps[i] = model.displacement.reshape(m, m) - surface
+            # Tamaas's displacement equals the surface where in contact: gap = u - z >= 0
+            gap = model.displacement.reshape(m, m) - surface if fields else None
+            rec.record(i, model.traction.reshape(m, m), gap, err, sec)
             if report is not None:
                 report(1)
-        pressure = np.array(model.traction.reshape(m, m), copy=True)
-    return LoadPath(alpha, alpha_pixels, p_max, per, residual, seconds, pressure, pressures, gaps)
+        rec.pressure = np.array(model.traction.reshape(m, m), copy=True)  # also for no loads
+    return rec.path()
