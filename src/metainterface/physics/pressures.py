@@ -143,14 +143,28 @@ def solve_delta(
             newton_fn = independent_load(gamma, h, settings)
         else:
             newton_fn = functools.partial(fn, gamma, h, settings)
-        grid = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
-        coarse = newton_fn(delta=grid.expand(gamma.shape[0], -1))
-        knots = coarse.delta
+        knots_fn = getattr(newton_fn, "knots", None)
+        if knots_fn is not None:  # an adhesive path: no snap-in inside a bracket
+            grid = knots_fn(n_delta)
+        else:
+            grid = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
+            grid = grid.expand(gamma.shape[0], -1)
+        coarse = newton_fn(delta=grid)
+        knots = coarse.delta.expand(gamma.shape[0], -1)
         p_max = coarse.p_star[:, -1]
         beyond = p_star >= p_max[:, None]
         delta = interp(p_star, coarse.p_star, knots)
-        step = float(knots[0, 1] - knots[0, 0])
-        lo, hi = (delta - step).clamp_min(0.0), (delta + step).clamp_max(settings.delta_max)
+        if knots_fn is not None:
+            # the knots around the first crossing of the running maximum: the rising force
+            # reaches p_star there, and no touch lies between them
+            k = torch.searchsorted(coarse.p_star.contiguous(), p_star.contiguous())
+            k = k.clamp(1, knots.shape[-1] - 1)
+            lo, hi = knots.gather(-1, k - 1), knots.gather(-1, k)
+            delta = torch.minimum(torch.maximum(delta, lo), hi)
+        else:
+            step = float(knots[0, 1] - knots[0, 0])
+            lo = (delta - step).clamp_min(0.0)
+            hi = (delta + step).clamp_max(settings.delta_max)
         tol = max(NEWTON_TOL, 64 * torch.finfo(p_star.dtype).eps) * p_star.abs()
         for _ in range(NEWTON_STEPS):
             sw = newton_fn(delta=delta)
