@@ -34,8 +34,12 @@ def adhesive_cell_curve(
 
     The cell: 9 asperities of the paper's space, gamma in [1.8, 4.0] and heights in
     [0, 0.6] Delta_max drawn with ``seed``, under ``Independent(adhesion)`` (w / (E* R)).
-    P* runs from 0 (alpha there is the state just after the cell snaps in) to ``top`` times
-    the largest pressure it reaches.
+    P* runs from 0 to ``top`` times the largest pressure it reaches. Each row is the exact
+    law at its load (``alpha_at(exact=True)``: Newton on P*(Delta), no interpolation in a
+    sweep, which smears a snap-in between its samples), and the zero-load row the state
+    where the rising force first holds zero load (the end of the snap-in's plateau at P* = 0,
+    as the package defines F_0): a cell whose first snap-in pulls a second tip into contact
+    at zero force has both in contact there.
     """
     import torch
 
@@ -52,7 +56,5 @@ def adhesive_cell_curve(
     with torch.no_grad():
         p_max = float(model.sweep(gt, ht, s, n_delta=2049).p_star[0, -1])
         p = np.linspace(0, top * p_max, rows)
-        p[0] = 1e-12 * p_max  # the zero-load state, just above the snap-in plateau
-        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
-    p[0] = 0.0
+        a = model.alpha_at(gt, ht, s, torch.as_tensor(p)[None], exact=True)[0][0].numpy()
     return p, a
