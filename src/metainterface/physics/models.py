@@ -309,7 +309,7 @@ class ForwardModel(ABC):
     def newton_load(self, gamma: Tensor, h: Tensor, settings: CellSettings) -> Callable[..., Sweep]:
         """``load(delta=...)``: P* and ``load_slope`` of (B, N) designs at Deltas (B, M), for
         the Newton steps of ``pressures.solve_delta``; the sweep unless a model has less.
-        With adhesion, a :class:`PathLoad`: its first brackets hold no snap-in."""
+        With adhesion, a ``PathLoad``: its first brackets hold no snap-in."""
         load = functools.partial(self.sweep, gamma, h, settings)
         return PathLoad(load, h, settings) if self.adhesion else load
 
