@@ -166,6 +166,9 @@ def solve_delta(
             lo = (delta - step).clamp_min(0.0)
             hi = (delta + step).clamp_max(settings.delta_max)
         tol = max(NEWTON_TOL, 64 * torch.finfo(p_star.dtype).eps) * p_star.abs()
+        # round-off of a force summed to P*_max is the floor (a zero load read just above
+        # the snap-in plateau, 1e-12 of the top load, cannot be met to 1e-10 of itself)
+        tol = torch.maximum(tol, 64 * torch.finfo(p_star.dtype).eps * p_max[:, None])
         for _ in range(NEWTON_STEPS):
             sw = newton_fn(delta=delta)
             if sw.load_slope is None:
