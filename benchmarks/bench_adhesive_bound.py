@@ -26,10 +26,8 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 import metainterface as mi
-from metainterface._testing import adhesive_cell_curve
+from metainterface._testing import adhesive_cell_curve, held_back_cell
 from metainterface.verify.check import bem_check
 
 E, R, W_J = 2.4e6, 0.5e-3, 0.05
@@ -49,10 +47,8 @@ def main() -> None:
         return
     w = W_J / (E * R)
     s = mi.CellSettings()
-    rng = np.random.default_rng(11)  # the cell of adhesive_cell_curve(seed=11)
-    g = rng.uniform(1.8, 4.0, 9)
-    h = rng.uniform(0, 0.6, 9) * s.delta_max
-    design = mi.Design(gamma=g, h=h - h.min(), settings=s)
+    g, h = held_back_cell(11, s)  # the cell of adhesive_cell_curve(seed=11)
+    design = mi.Design(gamma=g, h=h, settings=s)
     p, a = adhesive_cell_curve(w, seed=11, rows=24)
     target = mi.Target(p_star=p, alpha=a, name="held-back")
     busy = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(args.busy)]

@@ -32,7 +32,7 @@ import warnings
 from pathlib import Path
 
 import metainterface as mi
-from metainterface._testing import adhesive_cell_curve
+from metainterface._testing import adhesive_cell_curve, held_back_cell
 
 E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
 #: Laws the offset polish's settings and the adhesive fallback threshold were chosen on.
@@ -151,17 +151,14 @@ def own_error(seed: int, p, a) -> float:
     package scores designs on: the floor of what any design can read. The rows are exact,
     but the error resamples them linearly onto 128 pressures, across the snap-in steps that
     fall between two rows."""
-    import numpy as np
     import torch
 
     from metainterface.inverse.losses import TargetGrid, relative_error
 
     s = mi.CellSettings()
-    rng = np.random.default_rng(seed)  # the cell of adhesive_cell_curve(seed=seed)
-    g = rng.uniform(1.8, 4.0, 9)
-    h = rng.uniform(0, 0.6, 9) * s.delta_max
+    g, h = held_back_cell(seed, s)  # the cell of adhesive_cell_curve(seed=seed)
     grid = TargetGrid.from_curves([(p, a)], 128)
-    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h - h.min())[None]
+    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
     return float(relative_error(gt, ht, s, grid, mi.Independent(adhesion=W_J / (E * R)))[0])
 
 

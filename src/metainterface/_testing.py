@@ -27,13 +27,25 @@ def borderline_laws(
     return out
 
 
+def held_back_cell(seed: int, settings=None) -> tuple[np.ndarray, np.ndarray]:
+    """The held-back adhesive cell of ``seed``: gamma (9,) in [1.8, 4.0] and h (9,) [R] in
+    [0, 0.6] Delta_max, its lowest offset 0 (``settings``: default ``CellSettings()``)."""
+    from metainterface.physics.cell import CellSettings
+
+    s = settings or CellSettings()
+    rng = np.random.default_rng(seed)
+    g = rng.uniform(1.8, 4.0, 9)
+    h = rng.uniform(0, 0.6, 9) * s.delta_max
+    return g, h - h.min()
+
+
 def adhesive_cell_curve(
     adhesion: float, seed: int = 11, rows: int = 24, top: float = 0.95
 ) -> tuple[np.ndarray, np.ndarray]:
     """A held-back adhesive cell's loading curve under a rising force, (P*, alpha) (rows,).
 
-    The cell: 9 asperities of the paper's space, gamma in [1.8, 4.0] and heights in
-    [0, 0.6] Delta_max drawn with ``seed``, under ``Independent(adhesion)`` (w / (E* R)).
+    The cell: :func:`held_back_cell` of ``seed`` (9 asperities of the paper's space),
+    under ``Independent(adhesion)`` (w / (E* R)).
     P* runs from 0 to ``top`` times the largest pressure it reaches. Each row is the exact
     law at its load (``alpha_at(exact=True)``: Newton on P*(Delta), no interpolation in a
     sweep, which smears a snap-in between its samples), and the zero-load row the state
@@ -47,10 +59,7 @@ def adhesive_cell_curve(
     from metainterface.physics.models import Independent
 
     s = CellSettings()
-    rng = np.random.default_rng(seed)
-    g = rng.uniform(1.8, 4.0, 9)
-    h = rng.uniform(0, 0.6, 9) * s.delta_max
-    h -= h.min()
+    g, h = held_back_cell(seed, s)
     model = Independent(adhesion=adhesion)
     gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
     with torch.no_grad():

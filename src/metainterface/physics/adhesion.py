@@ -26,6 +26,7 @@ no loops over samples or asperities (only over Newton steps).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import torch
@@ -389,3 +390,30 @@ def pull_off(
             cand, cand_f = best_d, best_f
         where = cand.gather(-1, cand_f.argmin(-1, keepdim=True))
     return -force_at(where)[:, 0]
+
+
+@dataclass(frozen=True)
+class PathLoad:
+    """An adhesive model's load for ``pressures.solve_delta``: the sweep at the Deltas
+    asked (``load(delta=...)``), and ``knots(n_delta)``, the Deltas of its first brackets:
+    uniform ones and one just short of each asperity's touch (:func:`touch_grid`).
+
+    The force drops where an asperity touches and snaps in; under a rising force the cell
+    passes that drop at the touch's force. The running maximum along a few Deltas misses a
+    touch that falls between two of them, and a Newton step could land past it, on the
+    force's recovery, in a state the rising force jumps over; with a knot at every touch no
+    bracket holds one, and the force rises across each.
+    """
+
+    load: Callable[..., Sweep]
+    h: Tensor
+    settings: CellSettings
+
+    def __call__(self, *, delta: Tensor) -> Sweep:
+        return self.load(delta=delta)
+
+    def knots(self, n_delta: int | None) -> Tensor:
+        """(B, K + N) ascending Deltas [length]: ``n_delta`` uniform (default
+        settings.n_steps) and the touches."""
+        k = n_delta if n_delta is not None else self.settings.n_steps
+        return touch_grid(self.h, self.settings, k)

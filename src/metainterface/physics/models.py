@@ -54,33 +54,6 @@ N_DELTA_DENSE = 8193
 ZERO_LOAD = 1e-12
 
 
-@dataclass(frozen=True)
-class PathLoad:
-    """An adhesive model's load for ``pressures.solve_delta``: the sweep at the Deltas
-    asked (``load(delta=...)``), and ``knots(n_delta)``, the Deltas of its first brackets:
-    uniform ones and one just short of each asperity's touch (``adhesion.touch_grid``).
-
-    The force drops where an asperity touches and snaps in; under a rising force the cell
-    passes that drop at the touch's force. The running maximum along a few Deltas misses a
-    touch that falls between two of them, and a Newton step could land past it, on the
-    force's recovery, in a state the rising force jumps over; with a knot at every touch no
-    bracket holds one, and the force rises across each.
-    """
-
-    load: Callable[..., Sweep]
-    h: Tensor
-    settings: CellSettings
-
-    def __call__(self, *, delta: Tensor) -> Sweep:
-        return self.load(delta=delta)
-
-    def knots(self, n_delta: int | None) -> Tensor:
-        """(B, K + N) ascending Deltas [length]: ``n_delta`` uniform (default
-        settings.n_steps) and the touches."""
-        k = n_delta if n_delta is not None else self.settings.n_steps
-        return jkr.touch_grid(self.h, self.settings, k)
-
-
 class ForwardModel(ABC):
     """The protocol of a forward model: subclass it, implement the two sweeps, register it.
 
@@ -311,7 +284,7 @@ class ForwardModel(ABC):
         the Newton steps of ``pressures.solve_delta``; the sweep unless a model has less.
         With adhesion, a ``PathLoad``: its first brackets hold no snap-in."""
         load = functools.partial(self.sweep, gamma, h, settings)
-        return PathLoad(load, h, settings) if self.adhesion else load
+        return jkr.PathLoad(load, h, settings) if self.adhesion else load
 
     def alpha_at_loads(
         self,

@@ -181,8 +181,6 @@ def rising_branch(
 ) -> RisingBranch:
     """``design`` in the JKR-limit BEM on ``grid``^2 by ``samples`` approaches up to a step
     past the model's load ``top`` (P*), work of adhesion ``model.adhesion`` [E* R]."""
-    import time
-
     from metainterface._device import resolve_device
     from metainterface.validation.heightmap import height_map
 
