@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Sequence
-from dataclasses import replace
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -134,6 +134,49 @@ def design(
 
     Returns one DesignResult per target (one, not a list, for a single target).
     """
+    results, finish = designed(
+        targets,
+        method=method,
+        model=model,
+        settings=settings,
+        effort=effort,
+        scale=scale,
+        robust=robust,
+        max_pressure=max_pressure,
+        z_step=z_step,
+        verify=verify,
+        force=force,
+        device=device,
+        out=out,
+        full_target=full_target,
+        **deprecated,
+    )
+    return finish(results)
+
+
+def designed(
+    targets: Target | str | Sequence[Target | str],
+    *,
+    method: str = "surrogate",
+    model: str | ForwardModel | None = None,
+    settings: CellSettings | None = None,
+    effort: Effort | None = None,
+    scale: Scale | None = None,
+    robust: bool | Robust = False,
+    max_pressure: float | str | None = None,
+    z_step: float | str | None = None,
+    verify: bool | Verify = True,
+    force: bool = False,
+    device: str = "auto",
+    out: str | os.PathLike[str] | None = None,
+    full_target: bool = False,
+    **deprecated: Any,
+) -> tuple[list[DesignResult], Finish]:
+    """:func:`design` in two steps: the designs before their BEM check, and the
+    :class:`Finish` that checks (and corrects) them, notes their adhesion and writes them,
+    as ``design`` with these arguments would; ``finish(results)`` returns what ``design``
+    returns. The scale search designs its finalists with the first, checks them in turn
+    and writes only the one it keeps."""
     knobs, size, errors = option_groups(deprecated, effort, scale, robust)
     starts, hedge, fallback, refine, seed = (
         knobs["starts"],
@@ -231,17 +274,38 @@ def design(
         results = [_robust_stats(r, perturb, seed, dev) for r in results]
     if step is not None:
         results = [_printable_record(r, radius_m) for r in results]
-    if checks is not None:
-        results = _verify_all(
-            results, checks, extra_loss, refine_settings, step, perturb, limit, modulus
-        )
-    # after the BEM's correction: the notes are of the design that is returned and written
-    results = [replace(r, notes=(*r.notes, *adhesion_notes(r))) for r in results]
-    if out is not None:
-        out = Path(out)
-        folders = [out] if single else [out / r.target.name for r in results]
-        _save_all(results, folders, physical, full_target)
-    return results[0] if single else results
+
+    def check(results: list[DesignResult], correct: bool | None = None) -> list[DesignResult]:
+        if checks is not None:
+            asked = checks if correct is None else replace(checks, correct=correct)
+            results = _verify_all(
+                results, asked, extra_loss, refine_settings, step, perturb, limit, modulus
+            )
+        # after the BEM's correction: the notes are of the design returned and written
+        return [replace(r, notes=(*r.notes, *adhesion_notes(r))) for r in results]
+
+    def save(results: list[DesignResult]) -> DesignResult | list[DesignResult]:
+        if out is not None:
+            folders = [Path(out)] if single else [Path(out) / r.target.name for r in results]
+            _save_all(results, folders, physical, full_target)
+        return results[0] if single else results
+
+    return results, Finish(check, save, checks)
+
+
+@dataclass(frozen=True)
+class Finish:
+    """What :func:`designed` leaves to do: ``check(results, correct=None)`` (the BEM check
+    and its correction as ``verify`` asked, or with ``correct`` instead; the adhesion
+    notes) and ``save`` (the files, as asked; returns what :func:`design` returns).
+    Called, both. ``verify``: the check asked, None for none."""
+
+    check: Callable[..., list[DesignResult]]
+    save: Callable[[list[DesignResult]], DesignResult | list[DesignResult]]
+    verify: Verify | None
+
+    def __call__(self, results: list[DesignResult]) -> DesignResult | list[DesignResult]:
+        return self.save(self.check(results))
 
 
 def affordable_rows(
