@@ -136,7 +136,7 @@ def main() -> None:
             if floor <= 2.0:
                 meetable += 1
                 met_meetable += ok
-            bem = f" {100 * r.bem_error:.2f} % |" if args.verify else ""
+            bem = f" {r.bem.error_text()} |" if args.verify else ""
             print(
                 f"| {seed} | {tau / 1e3:.4g} kPa, {work * 1e3:.4g} mJ/m^2 | {area * 1e4:.3g} cm^2 "
                 f"| {100 * r.error:.2f} % | {f0:.2f} % | {floor:.2f} % |{bem}"
