@@ -48,12 +48,12 @@ def main() -> None:
     start, wall = cpu(), time.perf_counter()
     marks: list[tuple[str, float]] = []
     import metainterface.cli as cli
-    import metainterface.designer.run as run
+    import metainterface.designer.finish as finish
     import metainterface.inverse.envelope as envelope
     import metainterface.inverse.pipeline as pipeline
 
-    timed(run, "_verify_all", "BEM check", marks)
-    timed(run, "_save_all", "files and figure", marks)
+    timed(finish, "verify_all", "BEM check", marks)
+    timed(finish, "save_all", "files and figure", marks)
     timed(pipeline, "design", "design", marks)
     timed(envelope, "_envelope", "envelope", marks)
     marks.append(("imports", cpu() - start))

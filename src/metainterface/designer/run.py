@@ -6,22 +6,21 @@ from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from metainterface import _checks
 from metainterface._device import resolve_device
 from metainterface._files import check_output_folder, output_set
-from metainterface._files.provenance import current_command
 from metainterface._threads import uses_threads
 from metainterface.designer.adhesion import (
-    adhesion_notes,
     given_adhesion,
     model_for_targets,
 )
 from metainterface.designer.curve_result import reach_note
+from metainterface.designer.finish import Finish, pressure_check, save_all
 from metainterface.designer.given import _limit, _physical_options
 from metainterface.designer.options import (
     OLD_KEYWORDS,
@@ -36,18 +35,13 @@ from metainterface.designer.robust import _manufacturing, _printable_record, _ro
 from metainterface.errors import MetainterfaceError, ReachWarning
 from metainterface.inverse import pipeline
 from metainterface.inverse.envelope import reachability_warnings
-from metainterface.inverse.perturb import Perturbation
 from metainterface.inverse.refine import RefineSettings
 from metainterface.inverse.targets import Target
 from metainterface.inverse.verdict import refuse_unreachable
 from metainterface.physics.cell import CellSettings, Design
-from metainterface.physics.limits import PressureCheck, check_pressure, pressure_penalty
+from metainterface.physics.limits import pressure_penalty
 from metainterface.physics.models import ForwardModel
 from metainterface.physics.registry import get_model
-from metainterface.units.dimensions import physical_block
-from metainterface.units.quantities import (
-    parse_pressure,
-)
 from metainterface.verify.check import Verify, as_verify
 
 #: Upper bounds that keep a request within this machine's memory and a sane run time.
@@ -275,37 +269,20 @@ def designed(
     if step is not None:
         results = [_printable_record(r, radius_m) for r in results]
 
-    def check(results: list[DesignResult], correct: bool | None = None) -> list[DesignResult]:
-        if checks is not None:
-            asked = checks if correct is None else replace(checks, correct=correct)
-            results = _verify_all(
-                results, asked, extra_loss, refine_settings, step, perturb, limit, modulus
-            )
-        # after the BEM's correction: the notes are of the design returned and written
-        return [replace(r, notes=(*r.notes, *adhesion_notes(r))) for r in results]
-
-    def save(results: list[DesignResult]) -> DesignResult | list[DesignResult]:
-        if out is not None:
-            folders = [Path(out)] if single else [Path(out) / r.target.name for r in results]
-            _save_all(results, folders, physical, full_target)
-        return results[0] if single else results
-
-    return results, Finish(check, save, checks)
-
-
-@dataclass(frozen=True)
-class Finish:
-    """What :func:`designed` leaves to do: ``check(results, correct=None)`` (the BEM check
-    and its correction as ``verify`` asked, or with ``correct`` instead; the adhesion
-    notes) and ``save`` (the files, as asked; returns what :func:`design` returns).
-    Called, both. ``verify``: the check asked, None for none."""
-
-    check: Callable[..., list[DesignResult]]
-    save: Callable[[list[DesignResult]], DesignResult | list[DesignResult]]
-    verify: Verify | None
-
-    def __call__(self, results: list[DesignResult]) -> DesignResult | list[DesignResult]:
-        return self.save(self.check(results))
+    finish = Finish(
+        verify=checks,
+        extra_loss=extra_loss,
+        refine_settings=refine_settings,
+        z_step=step,
+        perturb=perturb,
+        limit=limit,
+        modulus=modulus,
+        out=out,
+        single=single,
+        physical=physical,
+        full_target=full_target,
+    )
+    return results, finish
 
 
 def affordable_rows(
@@ -344,36 +321,6 @@ def affordable_rows(
         )
 
 
-def _verify_all(
-    results: list[DesignResult],
-    checks: Verify,
-    extra_loss: Any,
-    refine_settings: RefineSettings | None,
-    step: float | None,
-    perturb: Perturbation | None,
-    limit: float | None,
-    modulus: Any,
-) -> list[DesignResult]:
-    """Each result checked (and where asked, corrected) in BEM; a corrected design gets its
-    pressure check again."""
-    from metainterface.designer.verified import verified
-
-    out = []
-    for r in results:
-        v = verified(
-            r,
-            checks,
-            extra_loss=extra_loss,
-            refine_settings=refine_settings,
-            z_step=step,
-            robust=perturb is not None,
-        )
-        if v.design is not r.design and r.pressure is not None:
-            v = replace(v, pressure=_pressure(v.design, limit, modulus))
-        out.append(v)
-    return out
-
-
 def _say_reach(
     items: list[Target], settings: CellSettings, reach: dict[str, Any], adhesion: float
 ) -> None:
@@ -392,17 +339,10 @@ def _say_reach(
             )
 
 
-def _pressure(d: Design, limit: float | None, modulus: Any) -> PressureCheck | None:
-    if limit is None:
-        return None
-    e_star = None if modulus is None else parse_pressure(modulus, option="modulus")
-    return check_pressure(d, limit if e_star is None else limit * e_star, e_star=e_star)
-
-
 def _public(r: pipeline.DesignResult, limit: float | None, modulus: Any) -> DesignResult:
     d = Design(gamma=r.gamma, h=r.h, settings=r.settings)
     notes = (*r.notes, *reachability_warnings(r.target, r.settings, r.model.adhesion))
-    pressure = _pressure(d, limit, modulus)
+    pressure = pressure_check(d, limit, modulus)
     out = DesignResult(
         target=r.target,
         design=d,
@@ -431,21 +371,6 @@ def _forced(r: DesignResult, reach: Any) -> DesignResult:
         reach.message.replace("\n", " ")
     )
     return replace(r, forced=True, notes=(note, *r.notes))
-
-
-def _save_all(
-    results: list[DesignResult],
-    folders: list[Path],
-    physical: dict | None,
-    full_target: bool = False,
-) -> None:
-    with output_set():  # every result's files, or none
-        for r, folder in zip(results, folders, strict=True):
-            command = current_command()
-            extra = {"command": command} if command else {}
-            if physical is not None:
-                extra["physical"] = physical_block(r.design, **physical)
-            r.save(folder, full_target=full_target, **extra)
 
 
 @uses_threads()
@@ -490,7 +415,7 @@ def compare(
             for i, t in enumerate(items):
                 per = [by_method[m][i] for m in pipeline.METHODS]
                 base = out if single else out / t.name
-                _save_all(per, [base / r.method for r in per], physical, full_target)
+                save_all(per, [base / r.method for r in per], physical, full_target)
                 fig = plot_comparison([per], [[r.curve() for r in per]])
                 save_figure(fig, base / "compare.png", command="compare")
     return by_method  # type: ignore[return-value]

@@ -15,6 +15,7 @@ from metainterface.inverse.refine import RefineSettings
 from metainterface.physics.cell import CellSettings
 from metainterface.physics.registry import get_model
 from metainterface.verify import Verify, bem_check, correct
+from metainterface.verify.bemcheck import BemCheck
 
 
 def verified(
@@ -25,13 +26,17 @@ def verified(
     refine_settings: RefineSettings | None = None,
     z_step: float | None = None,
     robust: bool = False,
+    check: BemCheck | None = None,
 ) -> DesignResult:
     """``r`` with its BEM check (``bem``) and, if ``settings`` asks for it, corrected: then
     ``design`` and ``error`` are the corrected design's, ``bem_before`` the first check,
     ``corrections`` every iteration, and ``bem`` the corrected design's check at the
     interleaved loads the correction did not fit (its error there is the one it reports;
-    the error at the fitted loads is the last kept iteration's)."""
-    check = bem_check(r.design, r.target, settings, r.model)
+    the error at the fitted loads is the last kept iteration's). ``check``: the design's
+    check already solved with ``settings`` (whatever they say of the correction), not
+    solved again."""
+    if check is None:
+        check = bem_check(r.design, r.target, settings, r.model)
     if not settings.wants_correction(check):
         return replace(r, bem=check)
     if robust:  # the correction re-refines the nominal design: it would undo the robustness

@@ -20,6 +20,7 @@ from metainterface.inverse.targets import Target
 from metainterface.physics.cell import CellSettings
 from metainterface.scaling import search as _scale
 from metainterface.scaling.candidates import _candidates, _quick_scores, _ranked, score
+from metainterface.scaling.finalists import checked_finalist, recorded
 
 #: Candidate scales designed quickly before the chosen one is designed in full.
 CANDIDATES = 5
@@ -30,9 +31,9 @@ QUICK = RefineSettings(
     stages=2, steps_per_stage=3, iterations=20, polish_iterations=20, reseed=False, offset=False
 )
 #: With adhesion the FINALISTS best quick scores are designed in full and checked in turn
-#: (``_checked_finalist``): a snap-in moves a quick score more than the scales differ, so
-#: the quick round's best can design in full to a worse score than its second. Without it
-#: the quick round ranks as the full designs do (benchmarks/results/adhesion.md).
+#: (``finalists.checked_finalist``): a snap-in moves a quick score more than the scales
+#: differ, so the quick round's best can design in full to a worse score than its second.
+#: Without it the quick round ranks as the full designs do (benchmarks/results/adhesion.md).
 FINALISTS = 2
 #: Options of the three scale variables, as the error messages name them.
 _OPTIONS = {"area": "area", "modulus": "modulus", "shear_strength": "shear_strength"}
@@ -296,64 +297,11 @@ def design_scale(
     }
     if not (at.adhesive and order.size > 1):
         r, finish = full(float(values[order[0]]))
-        return finish([_recorded(r, scores)])
+        return finish([recorded(r, scores)])
     finals = {float(values[i]): full(float(values[i])) for i in order[:FINALISTS]}
     scores["finalists"] = list(finals)
     scores["finalist_scores"] = [score(r) for r, _ in finals.values()]
-    return _checked_finalist(finals, scores, var)
-
-
-def _checked_finalist(
-    finals: dict[float, tuple[Any, Any]], scores: dict[str, Any], var: str
-) -> Any:
-    """Of the finalists (value: design before its check, its ``designed`` finish), the
-    one kept, checked and written: they are checked in turn (not corrected), the best model
-    score first, and the first that meets (its BEM check, F_0) is kept; where none does, the
-    one whose score plus BEM error is least. The model's score alone can prefer a design
-    that misses in BEM (``benchmarks/results/adhesion.md``). The kept one is then finished
-    as asked (corrected where its check calls for it); none is designed again, and only the
-    kept one is written."""
-    model_score = dict(zip(finals, scores["finalist_scores"], strict=True))
-    checked: dict[float, Any] = {}
-    for v in sorted(finals, key=model_score.__getitem__):
-        checked[v] = finals[v][1].check([finals[v][0]], correct=False)[0]
-        if _meets(checked[v]):
-            break
-    kept = next((v for v in checked if _meets(checked[v])), None)
-    if kept is None:
-        kept = min(checked, key=lambda v: score(checked[v]) + (checked[v].bem_error or 0.0))
-    r, finish = finals[kept]
-    verify = finish.verify
-    if verify is not None and checked[kept].bem is not None:
-        # the check as asked: the same check, and a correction where it calls for one
-        r = finish.check([r])[0] if verify.wants_correction(checked[kept].bem) else checked[kept]
-    else:
-        r = checked[kept]
-    if len(checked) > 1:  # the model's best missed: say what each finalist did
-        fmt = _scale.fmt_area if var == "area" else _scale.fmt_pressure
-        said = ", ".join(
-            f"{fmt(v)} (model {_percent(model_score[v])}, BEM {_percent(c.bem_error)}, "
-            f"F_0 {_percent(c.f0_error)})"
-            for v, c in checked.items()
-        )
-        note = f"scale: the finalists as checked: {said}; kept {fmt(kept)}"
-        r = replace(r, notes=(*r.notes, note))
-    scores = {
-        **scores,
-        "finalists_checked": list(checked),
-        "finalist_bem_errors": [c.bem_error for c in checked.values()],
-    }
-    return finish.save([_recorded(r, scores)])
-
-
-def _meets(result: Any) -> bool:
-    """Whether a checked design meets what was asked: its BEM check (where it ran) and
-    F_0 (an offset law's)."""
-    return (result.bem is None or bool(result.bem_ok)) and result.f0_met is not False
-
-
-def _percent(value: float | None) -> str:
-    return "-" if value is None else f"{100 * value:.3g} %"
+    return checked_finalist(finals, scores, var)
 
 
 @dataclass(frozen=True)
@@ -433,7 +381,7 @@ def _full_design(
 ) -> tuple[Any, Any]:
     """The full design at ``value`` of the scale variable before its BEM check, and what
     checks and writes it (``designer.run.designed``); the search's record in the target's
-    meta ("scale"), its scores added by :func:`_recorded`."""
+    meta ("scale"), its scores added by ``finalists.recorded``."""
     from metainterface.designer.run import designed
 
     n_cells, per_side = fs.tiles(at.scale(value)["area"])
@@ -445,16 +393,6 @@ def _full_design(
         warnings.simplefilter("ignore", UnitSlipWarning)
         results, finish = designed(t, settings=at.settings, **options)
     return results[0], finish
-
-
-def _recorded(result: Any, scores: dict[str, Any]) -> Any:
-    """The result with the search's candidates and scores in its target's meta ("scale")."""
-    t = result.target
-    scale = {**t.meta["scale"], **scores}
-    # the record's keys in the order design.json has always shown them
-    first = ("variable", "value", "searched", *scores, "n_cells", "tiles_per_side")
-    scale = {k: scale[k] for k in first} | scale
-    return replace(result, target=replace(t, meta={**t.meta, "scale": scale}))
 
 
 def scale_line(result: Any) -> str | None:
