@@ -8,8 +8,9 @@ it, on its two grids (``--grids``: coarse, fine; by default 192^2 and 384^2 at 1
 and on a reference grid twice the fine one with four times the approaches
 (``verify.adhesive.solve_adhesive``). Per law: the check's own accuracy estimate
 (``verify.adhesive.accuracy``, fine against coarse), the fine grid's difference to the
-reference (the same measure: the reference's curve interpolated at the fine grid's states,
-over the target's norm) and whether the estimate holds that difference.
+reference (the same measure: the reference's curve read at the fine grid's states, never
+across one of its snap-ins, over the target's norm) and whether the estimate holds that
+difference.
 
     PYTHONPATH=src python benchmarks/bench_adhesive_check_bound.py [--seeds 11 31 32]
         [--area-auto] [--grids 192 384 768] [--loads 10]

@@ -10,6 +10,7 @@ import pytest
 import torch
 
 import metainterface as mi
+from metainterface._threads import threads_for
 from metainterface.physics import CellSettings
 from metainterface.verify.adhesive import bounded_check, solve_adhesive
 
@@ -77,3 +78,75 @@ def test_a_bonded_solve_that_does_not_converge_is_an_error(hertz):
     z = torch.as_tensor(hm.heights)[None]
     with pytest.raises(mi.MetainterfaceError, match="did not converge"):
         ab.solve_jkr(z, hm.cell_side, torch.tensor([-float(z.mean()) - 0.01]), W, max_iter=2)
+
+
+def _cell(seed: int, n: int = 4, spread: float = 0.6):
+    """A random adhesive cell of n asperities (heights over ``spread`` Delta_max, so that
+    they snap in one after another) and its own loading curve under Independent(w)."""
+    s = CellSettings(n_asperities=n)
+    rng = np.random.default_rng(seed)
+    g = rng.uniform(1.8, 4.0, n)
+    h = rng.uniform(0, spread, n) * s.delta_max
+    h -= h.min()
+    model = mi.Independent(adhesion=W)
+    gt, ht = torch.as_tensor(g)[None], torch.as_tensor(h)[None]
+    with torch.no_grad():
+        p = np.linspace(0, 0.9 * float(model.sweep(gt, ht, s).p_star[0, -1]), 24)[1:]
+        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
+    return mi.Design(gamma=g, h=h, settings=s), mi.Target(p_star=p, alpha=a, name="cell"), model
+
+
+@pytest.mark.long
+@pytest.mark.parametrize("seed", [2, 4])
+def test_the_bound_holds_across_snap_ins_against_a_finer_path(seed):
+    # Several asperities snapping in: the estimate must hold the check's difference to a
+    # grid twice as fine sampled at four times the approaches (other loads, other jumps).
+    # That path is read here on its own terms: linearly, except near its jumps, found from
+    # its curve (a rise above four times its median step), not from the check's code.
+    design, target, model = _cell(seed)
+    b = bounded_check(design, target, model, grid=96, loads=8, max_error=0.02)
+    s = b.solved
+    with threads_for("light"):  # one thread, as the check runs (never spinning beside xdist)
+        ref = solve_adhesive(design, target, model, grid=192, loads=32)
+    rise = np.diff(ref.alpha_bem)
+    big = np.flatnonzero(rise > 4 * np.median(rise))
+    assert big.size >= 1  # the finer path does snap in within the range
+    lo, hi = ref.p_star[big][None] / 1.1, ref.p_star[big + 1][None] * 1.1
+    clear = ~((s.p_star[:, None] > lo) & (s.p_star[:, None] < hi)).any(1)
+    clear &= (s.p_star >= ref.p_star[0]) & (s.p_star <= ref.p_star[-1])
+    assert clear.sum() >= 3
+    p = s.p_star[clear]
+    diff = s.alpha_bem[clear] - np.interp(p, ref.p_star, ref.alpha_bem)
+    true = np.linalg.norm(diff) / np.linalg.norm(np.interp(p, target.p_star, target.alpha))
+    assert 0 < true <= b.accuracy
+
+
+def test_two_grids_with_one_snap_in_sampled_apart_agree():
+    # Both grids read the same curve, alpha = 0.02 + 10 P* below the snap-in at P* = 1e-3
+    # and 0.03 + 10 P* above it, at other loads: the coarse curve's last state before the
+    # jump and its first after are 40 % of the load apart. Read across that gap with a
+    # straight line it would differ from the fine one by up to the whole jump; read as the
+    # load-controlled curve it is (a step), the two agree.
+    from metainterface.verify.adhesive import AdhesiveSolved, accuracy
+
+    def curve(p, snap):
+        a = 0.02 + 10 * p + 0.01 * (p >= 1e-3)
+        return AdhesiveSolved(p, a, a, "cpu", 0.0, (), np.array([snap]))
+
+    fine = curve(
+        np.array([2e-4, 4e-4, 6e-4, 8e-4, 9.5e-4, 1.05e-3, 1.2e-3, 1.4e-3]), [9.5e-4, 1.02e-3]
+    )
+    coarse = curve(np.array([1e-4, 4e-4, 8e-4, 1.2e-3, 1.5e-3]), [8e-4, 1.1e-3])
+    target = mi.Target(p_star=np.linspace(0, 1.5e-3, 16), alpha=np.full(16, 0.04))
+    assert accuracy(fine, coarse, target) == pytest.approx(0.0, abs=1e-12)
+    # a coarse curve that jumps later than the fine one does differ, by the jump
+    late = AdhesiveSolved(
+        coarse.p_star,
+        0.02 + 10 * coarse.p_star + 0.01 * (coarse.p_star >= 1.3e-3),
+        coarse.alpha_bem,
+        "cpu",
+        0.0,
+        (),
+        np.array([[1.2e-3, 1.3e-3]]),
+    )
+    assert accuracy(fine, late, target) > 0.05

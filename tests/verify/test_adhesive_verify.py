@@ -45,15 +45,21 @@ def sticky_target():
 
 
 @pytest.fixture(scope="module")
-def corrected(sticky_target):
+def corrected():
+    """A design whose check reads an error well outside its own accuracy (a cell taller
+    than ``sticky_target``'s, loaded to its reach: 6.9 % +- 3 % at 96^2), so that the
+    correction runs; at 48^2 and 4 loads the check's accuracy is as large as its error, and
+    the correction rightly stops there."""
     model = mi.Independent(adhesion=W)
-    checks = mi.Verify(grid=48, loads=4, correct=True, iterations=1, restart=False, inner=None)
+    target = _held_back(3, 1.0, 16, 1.0)[1]
+    checks = mi.Verify(grid=96, loads=6, correct=True, iterations=1, restart=False, inner=None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return mi.design(sticky_target, model=model, verify=checks, effort=QUICK)
+        return mi.design(target, model=model, verify=checks, effort=QUICK)
 
 
-def test_an_adhesive_design_is_checked_under_a_rising_force(corrected, sticky_target):
+def test_an_adhesive_design_is_checked_under_a_rising_force(corrected):
+    sticky_target = _held_back(3, 1.0, 16, 1.0)[1]
     check = corrected.bem
     assert check is not None and check.adhesion == pytest.approx(W)
     # the loads are the BEM path's states a rising force reaches, inside the target's range
@@ -103,8 +109,8 @@ def test_cli_exit_status_follows_the_adhesive_bem_error(sticky_target, tmp_path,
     rows = "\n".join(f"{p!r},{a!r}" for p, a in pairs)
     csv.write_text("p_star,alpha\n" + rows + "\n")
     args = ["design", "--target-csv", str(csv), "--modulus", "2.4MPa", "--radius", "0.5mm"]
-    args += ["--work-of-adhesion", "50mJ/m2", "--refine", "none", "--verify-grid", "48"]
-    args += ["--verify-loads", "4", "--no-correct"]
+    args += ["--work-of-adhesion", "50mJ/m2", "--refine", "none", "--verify-grid", "96"]
+    args += ["--verify-loads", "6", "--no-correct"]
     out = tmp_path / "tight"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -7,7 +7,8 @@ cell by approach (displacement control: an adhesive contact has unstable branche
 control would jump), at K approaches from touch up to a step past where the model reaches
 the top load (``jkr_path``, each state warm-started from the one before). The states a
 rising force reaches, those whose force is at its running maximum and positive and clear of
-the model's snap-ins (``clear_of_snap_ins``), are the BEM's load-controlled curve. Both
+the model's snap-ins (``clear_of_snap_ins``) and of the BEM's own (``own_snap_ins``), are
+the BEM's load-controlled curve. Both
 design's check (``verify.adhesive``) and ``validate`` of an adhesive design
 (``adhesive_validate``) read it.
 """
@@ -154,17 +155,64 @@ def clear_of_snap_ins(p_star: np.ndarray, touching: np.ndarray, peaks: np.ndarra
     return ~((skipped | at_jump) & snaps).any(1)
 
 
+def own_snap_ins(p_star: np.ndarray, touching: np.ndarray) -> np.ndarray:
+    """(J, 2) the BEM's own snap-in loads as far as its samples tell, [lo, hi] P* for each
+    asperity that touches after the first sample.
+
+    Loaded by approach, asperity i first touches between samples k - 1 and k: a rising
+    force jumps at the load the cell carries just before that touch, at least the running
+    maximum before k (lo), and at most lo plus the force the untouched cell gains over one
+    approach step. That gain is at most the step after the touch (k to k + 1, or the first
+    later step with no new asperity touching): the cell's stiffness, dP*/d(approach), only
+    grows as contacts grow, and the touched cell has more of them (hi). Where no such step
+    was sampled the last rising step is repeated. ``p_star`` (K,) along uniform rising
+    approaches, ``touching`` (K, N) bool.
+    """
+    count = touching.sum(1)
+    clean = np.flatnonzero(count[1:] == count[:-1])  # steps j -> j + 1 with no new touch
+    out = []
+    for i in range(touching.shape[1]):
+        first = np.flatnonzero(touching[:, i])
+        if not first.size or first[0] == 0:
+            continue
+        k = int(first[0])
+        low = max(0.0, float(p_star[:k].max()))
+        after = clean[clean >= k]
+        if after.size:
+            step = float(p_star[after[0] + 1] - p_star[after[0]])
+        else:
+            step = float(np.max(np.diff(p_star[:k]), initial=0.0))
+        out.append((low, low + max(step, 0.0)))
+    return np.array(out).reshape(-1, 2)
+
+
+def clear_of_own_snap_ins(p_star: np.ndarray, touching: np.ndarray) -> np.ndarray:
+    """(K,) bool: the states not strictly between the bounds of one of the BEM's own snap-in
+    loads (``own_snap_ins``).
+
+    Between them a state reads either side of a jump depending on where the samples fall:
+    two grids, or the same grid with other approaches, put it on different sides, and that
+    one state's jump outweighs the grid's error at all the others.
+    """
+    snaps = own_snap_ins(p_star, touching)
+    p = p_star[:, None]
+    return ~((p > snaps[None, :, 0]) & (p < snaps[None, :, 1])).any(1)
+
+
 @dataclass(frozen=True)
 class RisingBranch:
     """The adhesive BEM's path of a cell and which of its states a rising force reaches.
 
     path: the BEM's states by approach (``AdhesivePath``); keep: (K,) bool,
     the states on the rising-force branch clear of snap-ins and at most ``top`` (the load
-    asked up to); approaches: (K,) [length]; device: where it solved; seconds: wall time.
+    asked up to); snap_ins: (J, 2) the BEM's own snap-in loads (``own_snap_ins``, sorted);
+    approaches: (K,) [length]; device: where it solved;
+    seconds: wall time.
     """
 
     path: AdhesivePath
     keep: np.ndarray
+    snap_ins: np.ndarray
     approaches: np.ndarray
     device: str
     seconds: float
@@ -198,6 +246,8 @@ def rising_branch(
     keep = (
         path.on_branch
         & clear_of_snap_ins(path.p_star, path.touching, model.touch_loads(design))
+        & clear_of_own_snap_ins(path.p_star, path.touching)
         & (path.p_star <= top * (1 + 1e-9))
     )
-    return RisingBranch(path, keep, deltas, str(dev), seconds)
+    snaps = own_snap_ins(path.p_star, path.touching)
+    return RisingBranch(path, keep, snaps[np.argsort(snaps[:, 0])], deltas, str(dev), seconds)

@@ -29,6 +29,14 @@ difference is about twice the fine grid's error, so the estimate bounds it: on a
 asperity against JKR, 14 % estimated against 6.2 % true at 64^2, 6.2 % against 2.9 % at
 128^2 (``tests/verify/test_adhesive_bound.py`` checks it there and against a finer grid).
 
+A cell of several asperities jumps where each snaps in, and a state at a jump reads either
+side of it depending on where the approaches fall, on one grid and the next alike. So the
+check leaves out the states within its own snap-ins' bounds (``own_snap_ins``: the loads a
+rising force may jump at, as far as the samples tell), and reads the coarse curve piece by
+piece between its snap-ins, never across one (``read_across_jumps``). Without that, a
+single state at a jump could put the check off a finer grid by several times the estimate
+(``benchmarks/bench_adhesive_check_bound.py``, figures in ``benchmarks/results/adhesion.md``).
+
 Without a grid given, the check starts at ``GRID_START`` points per asperity and doubles,
 the last fine grid now the coarse one, while that estimate is above ``BOUND_SHARE`` of
 ``Verify.max_error`` and would fall below it by ``GRID_MAX`` per asperity at the assumed
@@ -40,7 +48,7 @@ beside its error, and the correction stops there.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import torch
@@ -71,7 +79,8 @@ ORDER = 1.0
 @dataclass(frozen=True)
 class AdhesiveSolved:
     """The adhesive check's BEM path at the states a rising force reaches inside the
-    target's range: p_star, alpha_bem, alpha_model (K,); device, wall time [s], notes."""
+    target's range: p_star, alpha_bem, alpha_model (K,); device, wall time [s], notes;
+    snap_ins (J, 2): the BEM's own snap-in loads, [lo, hi] P* (sorted), where it jumps."""
 
     p_star: np.ndarray
     alpha_bem: np.ndarray
@@ -79,6 +88,7 @@ class AdhesiveSolved:
     device: str
     seconds: float
     notes: tuple[str, ...]
+    snap_ins: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
 
 def solve_adhesive(
@@ -123,23 +133,52 @@ def solve_adhesive(
             f"the adhesive BEM's rising branch reaches P* = {p[-1]:.4g} in the target's "
             f"range, short of {top:.4g}: the check stops there"
         )
-    return AdhesiveSolved(p, path.alpha[keep], mod, str(dev), seconds, tuple(notes))
+    return AdhesiveSolved(
+        p, path.alpha[keep], mod, str(dev), seconds, tuple(notes), branch.snap_ins
+    )
 
 
 def accuracy(fine: AdhesiveSolved, coarse: AdhesiveSolved, target: Target) -> float:
     """The fine check's own error estimated from the coarse one (half its grid): the
-    relative L2 difference of their alpha_bem over the fine states within the coarse
-    path's range (the coarse curve interpolated there), over the target's norm there, times
-    1 / (2^ORDER - 1). inf where the two share no load."""
-    inside = (fine.p_star >= coarse.p_star[0]) & (fine.p_star <= coarse.p_star[-1])
+    relative L2 difference of their alpha_bem over the fine states the coarse curve reads
+    (``read_across_jumps``), over the target's norm there, times 1 / (2^ORDER - 1). inf
+    where the two share no load."""
+    other = read_across_jumps(fine.p_star, coarse.p_star, coarse.alpha_bem, coarse.snap_ins)
+    inside = np.isfinite(other)
     if not inside.any() or coarse.p_star.size < 2:
         return math.inf
     p = fine.p_star[inside]
-    diff = fine.alpha_bem[inside] - np.interp(p, coarse.p_star, coarse.alpha_bem)
+    diff = fine.alpha_bem[inside] - other[inside]
     norm = float(np.linalg.norm(np.interp(p, target.p_star, target.alpha)))
     if not norm > 0:
         return math.inf
     return float(np.linalg.norm(diff)) / norm / (2.0**ORDER - 1.0)
+
+
+def read_across_jumps(
+    x: np.ndarray, xp: np.ndarray, fp: np.ndarray, jumps: np.ndarray
+) -> np.ndarray:
+    """(K,) a load-controlled curve (states ``xp``, ``fp`` (S,), sorted) read at loads ``x``
+    (K,): linear within each piece between its ``jumps`` ((J, 2): each snap-in's load
+    between lo and hi) and extrapolated from the piece's end states up to its jumps (one
+    state: its value), never across a jump (a straight line there would read a snap-in as
+    a slope); NaN within a jump's bounds (the curve may read either side there), outside
+    ``xp``'s range and in a piece without states."""
+    out = np.full(x.shape, np.nan)
+    cuts = np.sort(0.5 * (jumps[:, 0] + jumps[:, 1]))
+    piece_x = np.searchsorted(cuts, x)
+    piece_p = np.searchsorted(cuts, xp)
+    at_jump = ((x[:, None] > jumps[None, :, 0]) & (x[:, None] < jumps[None, :, 1])).any(1)
+    within = (x >= xp[0]) & (x <= xp[-1]) & ~at_jump
+    for j in np.unique(piece_x[within]):
+        at = within & (piece_x == j)
+        xs, ys = xp[piece_p == j], fp[piece_p == j]
+        if xs.size == 1:
+            out[at] = ys[0]
+        elif xs.size > 1:
+            k = np.clip(np.searchsorted(xs, x[at]), 1, xs.size - 1)
+            out[at] = ys[k - 1] + (ys[k] - ys[k - 1]) * (x[at] - xs[k - 1]) / (xs[k] - xs[k - 1])
+    return out
 
 
 @dataclass(frozen=True)
