@@ -48,8 +48,9 @@ beside its error, and the correction stops there.
 from __future__ import annotations
 
 import math
+import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -233,10 +234,9 @@ def bounded_check(
     # The two grids at once, on two Python threads (each one torch thread; a solve's FFTs
     # and CG steps release the GIL): on two cores, or beside busy processes, the pair takes
     # about the fine grid's time instead of both (``benchmarks/bench_adhesive_bound.py``)
-    with ThreadPoolExecutor(1) as pool:
-        later = pool.submit(solve, fine_grid)
-        coarse = solve(coarse_grid)
-        fine = later.result()
+    later = _in_background(solve, fine_grid)
+    coarse = solve(coarse_grid)
+    fine = later()
     grids = [coarse_grid, fine_grid]
     acc = accuracy(fine, coarse, target)
     bound = BOUND_SHARE * max_error
@@ -263,3 +263,27 @@ def bounded_check(
     )
     fine = replace(fine, notes=(*fine.notes, note))
     return BoundedCheck(fine, fine_grid, acc, tuple(grids), time.perf_counter() - start)
+
+
+def _in_background(fn: Callable[[int], AdhesiveSolved], arg: int) -> Callable[[], AdhesiveSolved]:
+    """``fn(arg)`` started on a daemon thread; the returned call waits for its result (or
+    raises its error). A daemon, so that an interrupt of the caller (Ctrl-C) ends the run
+    at once instead of waiting for this solve, as a pool's worker would."""
+    out: dict[str, object] = {}
+
+    def run() -> None:
+        try:
+            out["result"] = fn(arg)
+        except BaseException as exc:  # handed to the caller, which raises it
+            out["error"] = exc
+
+    thread = threading.Thread(target=run, name="adhesive-check", daemon=True)
+    thread.start()
+
+    def result() -> AdhesiveSolved:
+        thread.join()
+        if "error" in out:
+            raise out["error"]  # type: ignore[misc]
+        return out["result"]  # type: ignore[return-value]
+
+    return result
