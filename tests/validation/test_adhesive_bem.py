@@ -156,3 +156,25 @@ def test_jkr_limit_sphere_converges_with_the_grid():
     np.testing.assert_array_less(load, lb)
     np.testing.assert_array_less(unload, ub)
     assert max(load.max(), unload.max()) < 0.6 * max(coarse_load.max(), coarse_unload.max())
+
+
+def test_a_path_stopped_above_a_load_is_the_same_path_so_far():
+    # rising_branch stops loading after the first state above the load asked up to: the
+    # states solved are the full path's, and none after it is on the rising branch below
+    # that load (they are the ones not solved)
+    design = Design(
+        gamma=np.array([2.0, 3.0, 2.5, 1.9]),
+        h=np.array([0.0, 0.002, 0.004, 0.007]),
+        settings=CellSettings(n_asperities=4),
+    )
+    hm = height_map(design, 48)
+    approaches = np.linspace(0, 0.02, 13)[1:]
+    full = jkr_path(hm.heights, hm.cell_side, 4.2e-5, approaches)
+    top = float(np.quantile(full.p_star[full.p_star > 0], 0.5))
+    cut = jkr_path(hm.heights, hm.cell_side, 4.2e-5, approaches, stop_above=top)
+    k = cut.p_star.size
+    assert 0 < k < full.p_star.size and cut.p_star[-1] > top >= cut.p_star[:-1].max()
+    np.testing.assert_array_equal(cut.p_star, full.p_star[:k])
+    np.testing.assert_array_equal(cut.alpha, full.alpha[:k])
+    np.testing.assert_array_equal(cut.approach, approaches[:k])
+    assert not (full.on_branch[k:] & (full.p_star[k:] <= top)).any()
