@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import torch
 from torch import Tensor
 
@@ -150,7 +151,9 @@ def jkr_radius(
         # the coefficients once, not at every Newton step (lgamma is most of a step's cost)
         kc = power_coefficient(g0, radius)
         s = flat_punch_coefficient(w0, radius)
-        shape = torch.broadcast_shapes(a_t.shape, x0.shape, g0.shape)
+        # numpy's: torch.broadcast_shapes runs through torch._refs, whose first call imports
+        # sympy and torch.fx (0.3 s of a design's start)
+        shape = np.broadcast_shapes(a_t.shape, x0.shape, g0.shape)
         floor = torch.broadcast_to(a_d, shape)
         if start is not None:
             # where the start is off the branch (an asperity just in), a0: right of the root
