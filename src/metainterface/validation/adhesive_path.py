@@ -8,9 +8,8 @@ control would jump), at K approaches from touch up to a step past where the mode
 the top load (``jkr_path``, each state warm-started from the one before). The states a
 rising force reaches, those whose force is at its running maximum and positive and clear of
 the model's snap-ins (``clear_of_snap_ins``) and of the BEM's own (``own_snap_ins``), are
-the BEM's load-controlled curve. Both
-design's check (``verify.adhesive``) and ``validate`` of an adhesive design
-(``adhesive_validate``) read it.
+the BEM's load-controlled curve. Both design's check (``verify.adhesive``) and ``validate``
+of an adhesive design (``adhesive_validate``) read it.
 """
 
 from __future__ import annotations
@@ -81,13 +80,9 @@ def jkr_path(
     p_star, alpha, touching, share, p_max, residual, seconds = [], [], [], [], [], [], []
     n_owner = 0 if owner is None else int(owner.max()) + 1
     own = None if owner is None else torch.as_tensor(owner, device=z.device).reshape(-1)
-    solved_up = up.size
-    for i, d in enumerate(np.concatenate([up, down])):
-        if i < up.size and i >= solved_up:
-            continue  # loading stopped (stop_above)
-        if i < up.size and stop_above is not None and p_star and p_star[-1] > stop_above:
-            solved_up = i  # the loading ends here; the unloading (if any) goes on
-            continue
+
+    def solve(d: float) -> None:  # the state at approach d, from the one before
+        nonlocal contact, pressure
         start = time.perf_counter()
         target = torch.tensor([z_bar - d], dtype=torch.float64, device=z.device)
         sol = solve_jkr(z, side, target, work, contact=contact, pressure=pressure)
@@ -101,7 +96,14 @@ def jkr_path(
             touching.append((hits > 0).cpu().numpy())
             share.append((hits / own.numel()).cpu().numpy())
         seconds.append(time.perf_counter() - start)
-    up = up[:solved_up]
+
+    for i, d in enumerate(up):
+        solve(d)
+        if stop_above is not None and p_star[-1] > stop_above:
+            up = up[: i + 1]  # the loading ends here; the unloading (if any) goes on
+            break
+    for d in down:
+        solve(d)
     p = np.array(p_star)
     loading = np.arange(p.size) < up.size
     top = np.maximum.accumulate(np.where(loading, p, -np.inf))
@@ -167,7 +169,7 @@ def clear_of_snap_ins(p_star: np.ndarray, touching: np.ndarray, peaks: np.ndarra
 
 def own_snap_ins(p_star: np.ndarray, touching: np.ndarray) -> np.ndarray:
     """(J, 2) the BEM's own snap-in loads as far as its samples tell, [lo, hi] P* for each
-    asperity that touches after the first sample.
+    asperity that touches after the first sample, in increasing lo.
 
     Loaded by approach, asperity i first touches between samples k - 1 and k: a rising
     force jumps at the load the cell carries just before that touch, at least the running
@@ -193,20 +195,19 @@ def own_snap_ins(p_star: np.ndarray, touching: np.ndarray) -> np.ndarray:
         else:
             step = float(np.max(np.diff(p_star[:k]), initial=0.0))
         out.append((low, low + max(step, 0.0)))
-    return np.array(out).reshape(-1, 2)
+    return np.array(sorted(out)).reshape(-1, 2)
 
 
-def clear_of_own_snap_ins(p_star: np.ndarray, touching: np.ndarray) -> np.ndarray:
-    """(K,) bool: the states not strictly between the bounds of one of the BEM's own snap-in
-    loads (``own_snap_ins``).
+def at_snap_ins(p_star: np.ndarray, snap_ins: np.ndarray) -> np.ndarray:
+    """(K,) bool: the loads ``p_star`` (K,) strictly between the bounds of one of the
+    snap-ins ``snap_ins`` (J, 2) (``own_snap_ins``).
 
-    Between them a state reads either side of a jump depending on where the samples fall:
-    two grids, or the same grid with other approaches, put it on different sides, and that
-    one state's jump outweighs the grid's error at all the others.
+    A state there reads either side of a jump depending on where the samples fall: two
+    grids, or the same grid with other approaches, put it on different sides, and that one
+    state's jump outweighs the grid's error at all the others.
     """
-    snaps = own_snap_ins(p_star, touching)
     p = p_star[:, None]
-    return ~((p > snaps[None, :, 0]) & (p < snaps[None, :, 1])).any(1)
+    return ((p > snap_ins[None, :, 0]) & (p < snap_ins[None, :, 1])).any(1)
 
 
 @dataclass(frozen=True)
@@ -215,9 +216,8 @@ class RisingBranch:
 
     path: the BEM's states by approach (``AdhesivePath``); keep: (K,) bool,
     the states on the rising-force branch clear of snap-ins and at most ``top`` (the load
-    asked up to); snap_ins: (J, 2) the BEM's own snap-in loads (``own_snap_ins``, sorted);
-    approaches: (K,) [length]; device: where it solved;
-    seconds: wall time.
+    asked up to); snap_ins: (J, 2) the BEM's own snap-in loads (``own_snap_ins``);
+    approaches: (K,) [length]; device: where it solved; seconds: wall time.
     """
 
     path: AdhesivePath
@@ -264,11 +264,11 @@ def rising_branch(
     deltas = path.approach
     seconds = time.perf_counter() - t0
     assert path.touching is not None  # owner given
+    snaps = own_snap_ins(path.p_star, path.touching)
     keep = (
         path.on_branch
         & clear_of_snap_ins(path.p_star, path.touching, model.touch_loads(design))
-        & clear_of_own_snap_ins(path.p_star, path.touching)
+        & ~at_snap_ins(path.p_star, snaps)
         & (path.p_star <= top * (1 + 1e-9))
     )
-    snaps = own_snap_ins(path.p_star, path.touching)
-    return RisingBranch(path, keep, snaps[np.argsort(snaps[:, 0])], deltas, str(dev), seconds)
+    return RisingBranch(path, keep, snaps, deltas, str(dev), seconds)

@@ -65,6 +65,7 @@ from metainterface.validation.adhesive_path import (  # noqa: F401  (re-exported
     APPROACHES_PER_LOAD,
     TOUCH_MARGIN,
     approaches,
+    at_snap_ins,
     clear_of_snap_ins,
     rising_branch,
 )
@@ -83,7 +84,7 @@ ORDER = 1.0
 class AdhesiveSolved:
     """The adhesive check's BEM path at the states a rising force reaches inside the
     target's range: p_star, alpha_bem, alpha_model (K,); device, wall time [s], notes;
-    snap_ins (J, 2): the BEM's own snap-in loads, [lo, hi] P* (sorted), where it jumps."""
+    snap_ins (J, 2): the BEM's own snap-in loads, [lo, hi] P*, where it jumps."""
 
     p_star: np.ndarray
     alpha_bem: np.ndarray
@@ -171,8 +172,7 @@ def read_across_jumps(
     cuts = np.sort(0.5 * (jumps[:, 0] + jumps[:, 1]))
     piece_x = np.searchsorted(cuts, x)
     piece_p = np.searchsorted(cuts, xp)
-    at_jump = ((x[:, None] > jumps[None, :, 0]) & (x[:, None] < jumps[None, :, 1])).any(1)
-    within = (x >= xp[0]) & (x <= xp[-1]) & ~at_jump
+    within = (x >= xp[0]) & (x <= xp[-1]) & ~at_snap_ins(x, jumps)
     for j in np.unique(piece_x[within]):
         at = within & (piece_x == j)
         xs, ys = xp[piece_p == j], fp[piece_p == j]
