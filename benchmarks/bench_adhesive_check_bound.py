@@ -2,10 +2,10 @@
 
 Each law is a held-back adhesive cell's loading curve (``adhesive_cell_curve``, 24 rows) as
 a friction law over 4 cm^2 (tau 0.3 MPa, E* 2.4 MPa, R 0.5 mm, w 50 mJ/m^2, as
-``bench_offset_f0.py``), designed by the default path without the check (``--area-auto``:
-the area designed with the cell). The design's check is then solved as ``design`` solves
-it, on its two grids (``--grids``: coarse, fine; by default 192^2 and 384^2 at 10 loads),
-and on a reference grid twice the fine one with four times the approaches
+``bench_offset_f0.design_law``), designed by the default path without the check
+(``--area-auto``: the area designed with the cell). The design's check is then solved as
+``design`` solves it, on its two grids (``--grids``: coarse, fine; by default 192^2 and
+384^2 at 10 loads), and on a reference grid twice the fine one with four times the approaches
 (``verify.adhesive.solve_adhesive``). Per law: the check's own accuracy estimate
 (``verify.adhesive.accuracy``, fine against coarse), the fine grid's difference to the
 reference (the same measure: the reference's curve read at the fine grid's states, never
@@ -24,14 +24,12 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
-import warnings
 from pathlib import Path
 
 import metainterface as mi
-from metainterface._testing import adhesive_cell_curve
+from bench_offset_f0 import design_law
 from metainterface.verify.adhesive import ORDER, accuracy, solve_adhesive
 
-E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
 # Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
 QUICK = "--seeds 31 --grids 48 96 192 --loads 3 --zero-shot"
 
@@ -57,7 +55,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for seed in args.seeds:
             start = time.perf_counter()
-            r = _design(Path(tmp), seed, args.area_auto, effort)
+            r = design_law(Path(tmp), seed, args.area_auto, effort)
             solved = {
                 m: solve_adhesive(r.design, r.target, r.model, grid=m, loads=k)
                 for m, k in ((coarse_m, args.loads), (fine_m, args.loads), (ref_m, 4 * args.loads))
@@ -76,23 +74,6 @@ def main() -> None:
         f"\nthe estimate holds the fine grid's difference to the reference on {held} of "
         f"{len(args.seeds)} designs"
     )
-
-
-def _design(folder: Path, seed: int, area_auto: bool, effort: mi.Effort):
-    """The held-back law of ``seed`` designed without the check (as bench_offset_f0)."""
-    p, a = adhesive_cell_curve(W_J / (E * R), seed=seed, rows=24)
-    path = folder / f"law{seed}.csv"
-    path.write_text(
-        "normal_force,friction_force\n"
-        + "".join(f"{x:.12g},{y:.12g}\n" for x, y in zip(p * AREA * E, a * TAU * AREA, strict=True))
-    )
-    units = dict(shear_strength=TAU, modulus=E, radius=R, work_of_adhesion=W_J, fit="never")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        if area_auto:
-            return mi.design_scale(path, area="auto", verify=False, effort=effort, **units)
-        t = mi.Target.from_friction(path, area=AREA, **units)
-        return mi.design(t, verify=False, effort=effort)
 
 
 if __name__ == "__main__":

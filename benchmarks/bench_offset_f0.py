@@ -90,41 +90,11 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for seed in args.seeds:
             p, a = adhesive_cell_curve(W_J / (E * R), seed=seed, rows=24)
-            path = Path(tmp) / f"law{seed}.csv"
-            path.write_text(
-                "normal_force,friction_force\n"
-                + "".join(
-                    f"{x:.12g},{y:.12g}\n"
-                    for x, y in zip(p * AREA * E, a * TAU * AREA, strict=True)
-                )
-            )
             tau, work = _calibrated(seed) if args.calibrated else (TAU, W_J)
             start = time.perf_counter()
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                if args.area_auto:
-                    r = mi.design_scale(
-                        path,
-                        shear_strength=tau,
-                        modulus=E,
-                        radius=R,
-                        area="auto",
-                        work_of_adhesion=work,
-                        fit="never",
-                        verify=args.verify,
-                        effort=effort,
-                    )
-                else:
-                    t = mi.Target.from_friction(
-                        path,
-                        work_of_adhesion=work,
-                        shear_strength=tau,
-                        modulus=E,
-                        radius=R,
-                        area=AREA,
-                        fit="never",
-                    )
-                    r = mi.design(t, verify=args.verify, effort=effort)
+            r = design_law(
+                Path(tmp), seed, args.area_auto, effort, tau=tau, work=work, verify=args.verify
+            )
             area = r.target.meta["friction"]["area_m2"]
             errors.append(100 * r.error)
             f0 = 100 * r.f0_error if r.f0_error is not None else float("nan")
@@ -158,6 +128,34 @@ def main() -> None:
             f"{meetable} of {len(floors)} laws; of those, curve and F_0 both within 2 %{what}: "
             f"{met_meetable} of {meetable}"
         )
+
+
+def design_law(
+    folder: Path,
+    seed: int,
+    area_auto: bool,
+    effort: mi.Effort,
+    *,
+    tau: float = TAU,
+    work: float = W_J,
+    verify: bool = False,
+):
+    """The held-back law of ``seed`` (its cell's loading curve, 24 rows, as a friction law
+    over ``AREA``) written to ``folder`` and designed with ``tau`` [Pa] and ``work``
+    [J/m^2]: at ``AREA``, or with the area designed too (``area_auto``)."""
+    p, a = adhesive_cell_curve(W_J / (E * R), seed=seed, rows=24)
+    path = folder / f"law{seed}.csv"
+    path.write_text(
+        "normal_force,friction_force\n"
+        + "".join(f"{x:.12g},{y:.12g}\n" for x, y in zip(p * AREA * E, a * TAU * AREA, strict=True))
+    )
+    units = dict(shear_strength=tau, modulus=E, radius=R, work_of_adhesion=work, fit="never")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if area_auto:
+            return mi.design_scale(path, area="auto", verify=verify, effort=effort, **units)
+        t = mi.Target.from_friction(path, area=AREA, **units)
+        return mi.design(t, verify=verify, effort=effort)
 
 
 def own_error(seed: int, p, a) -> float:
