@@ -178,3 +178,56 @@ def test_a_path_stopped_above_a_load_is_the_same_path_so_far():
     np.testing.assert_array_equal(cut.alpha, full.alpha[:k])
     np.testing.assert_array_equal(cut.approach, approaches[:k])
     assert not (full.on_branch[k:] & (full.p_star[k:] <= top)).any()
+
+
+def test_a_path_restarted_midway_keeps_to_the_closed_form():
+    # jkr_path(restart=k): the approaches from k on are a second chain loaded from the rigid
+    # overlap (on another thread). Its states are loading states too: on a Hertz asperity
+    # each is within the pixel bound of JKR's a(P), as the continued path's; the first
+    # chain is the path itself
+    w, m = 4.2e-5, 128
+    design = Design(gamma=np.array([2.0]), h=np.array([0.0]), settings=CellSettings(n_asperities=1))
+    hm = height_map(design, m)
+    side = hm.cell_side
+    approaches = np.linspace(0, 0.02, 9)[1:]
+    full = jkr_path(hm.heights, side, w, approaches)
+    split = jkr_path(hm.heights, side, w, approaches, restart=4)
+    np.testing.assert_array_equal(split.approach, approaches)
+    np.testing.assert_array_equal(split.alpha[:4], full.alpha[:4])
+    force = split.p_star * side**2
+    assert (force > 0).sum() == 8
+    for f, alpha in zip(force, split.alpha, strict=True):
+        a = _jkr_radius_of_force(f, w)
+        bound = (1 + 0.5 * side / m / a) ** 2 - 1
+        assert abs(alpha * side**2 / (math.pi * a * a) - 1) < bound
+    # where the first chain stops above a load the second is dropped: the path so far
+    top = float(full.p_star[2])
+    np.testing.assert_array_equal(
+        jkr_path(hm.heights, side, w, approaches, restart=4, stop_above=top).p_star,
+        full.p_star[:4],
+    )
+    with pytest.raises(ValueError, match="restart"):
+        jkr_path(hm.heights, side, w, approaches, restart=0)
+
+
+def test_a_restarted_state_of_a_cell_is_the_continued_one_within_a_ring():
+    # on a cell of four asperities the start picks which of the grid's pinned edges a
+    # contact stops at: a restarted state's contact is the continued path's within one
+    # ring of boundary points of each asperity's contact (a disc's 4-connected boundary)
+    design = Design(
+        gamma=np.array([2.0, 3.0, 2.5, 1.9]),
+        h=np.array([0.0, 0.002, 0.004, 0.007]),
+        settings=CellSettings(n_asperities=4),
+    )
+    m = 96
+    hm = height_map(design, m)
+    approaches = np.linspace(0, 0.02, 13)[1:]
+    full = jkr_path(hm.heights, hm.cell_side, 4.2e-5, approaches, owner=hm.owner)
+    points = full.asperity_alpha * m * m
+    ring = ((4 / math.pi) * 2 * np.sqrt(math.pi * points)).sum(1)
+    for restart in (3, 5, 9):
+        split = jkr_path(
+            hm.heights, hm.cell_side, 4.2e-5, approaches, owner=hm.owner, restart=restart
+        )
+        np.testing.assert_array_equal(split.touching, full.touching)
+        assert (np.abs(split.alpha - full.alpha) * m * m <= ring).all()

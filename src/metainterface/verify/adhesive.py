@@ -232,8 +232,9 @@ def bounded_check(
     fine_grid = GRID_START * n if grid is None else check_grid(grid, s)
     coarse_grid = half(fine_grid)
     # The two grids at once, on two Python threads (each one torch thread; a solve's FFTs
-    # and CG steps release the GIL): on two cores, or beside busy processes, the pair takes
-    # about the fine grid's time instead of both (``benchmarks/bench_adhesive_bound.py``)
+    # and CG steps release the GIL), each path in two chains (``rising_branch``): on two
+    # cores, or beside busy processes, the check takes about half the fine path's time
+    # instead of both grids' (``benchmarks/bench_adhesive_bound.py``)
     later = _in_background(solve, fine_grid)
     coarse = solve(coarse_grid)
     fine = later()
