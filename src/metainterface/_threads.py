@@ -162,3 +162,31 @@ def uses_threads(work: Work = "light") -> Callable[[F], F]:
         return run  # type: ignore[return-value]
 
     return wrap
+
+
+T = TypeVar("T")
+
+
+def in_background(fn: Callable[[], T], name: str) -> Callable[[], T]:
+    """``fn()`` started on a daemon thread ``name``; the returned call waits for its result
+    (or raises its error). For torch work that releases the GIL (FFTs, conjugate-gradient
+    steps) beside the caller's own. A daemon, so that an interrupt of the caller (Ctrl-C)
+    ends the run at once instead of waiting for it, as a pool's worker would."""
+    out: dict[str, Any] = {}
+
+    def run() -> None:
+        try:
+            out["result"] = fn()
+        except BaseException as exc:  # handed to the caller, which raises it
+            out["error"] = exc
+
+    thread = threading.Thread(target=run, name=name, daemon=True)
+    thread.start()
+
+    def result() -> T:
+        thread.join()
+        if "error" in out:
+            raise out["error"]
+        return out["result"]
+
+    return result

@@ -15,13 +15,13 @@ of an adhesive design (``adhesive_validate``) read it.
 
 from __future__ import annotations
 
-import threading
 import time
 from dataclasses import dataclass
 
 import numpy as np
 import torch
 
+from metainterface._threads import in_background
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
@@ -174,24 +174,14 @@ def _chains(
 
     A restarted state is a loading state as well: the contact grows from the rigid overlap
     to the first stable set instead of from the state before, and the two differ only by
-    where the grid pins the edge (on the benchmark cell at 384^2, |d alpha| <= 1.8e-4 at
-    alpha ~ 0.06 over 16 restart points, below the check's own accuracy; the later states
-    agree as closely)."""
-    first: dict = {}
-
-    def run() -> None:
-        try:
-            first["result"] = _chain(z, side, work, up[:restart], up[:0], own, n_owner, stop_above)
-        except BaseException as exc:  # handed to the caller, which raises it
-            first["error"] = exc
-
-    thread = threading.Thread(target=run, name="adhesive-path", daemon=True)
-    thread.start()
+    where the grid pins the edge: a fraction of a ring of boundary points, well below the
+    check's own accuracy (``benchmarks/bench_adhesive_bound.py --restarts``)."""
+    first = in_background(
+        lambda: _chain(z, side, work, up[:restart], up[:0], own, n_owner, stop_above),
+        name="adhesive-path",
+    )
     second, _ = _chain(z, side, work, up[restart:], up[:0], own, n_owner, stop_above)
-    thread.join()
-    if "error" in first:
-        raise first["error"]
-    states, stopped = first["result"]
+    states, stopped = first()
     if stopped:
         return states
     return {k: (second[k] if k == "pressure" else states[k] + second[k]) for k in second}

@@ -48,15 +48,13 @@ beside its error, and the correction stops there.
 from __future__ import annotations
 
 import math
-import threading
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 import torch
 
-from metainterface._threads import uses_threads
+from metainterface._threads import in_background, uses_threads
 from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
@@ -235,7 +233,7 @@ def bounded_check(
     # and CG steps release the GIL), each path in two chains (``rising_branch``): on two
     # cores, or beside busy processes, the check takes about half the fine path's time
     # instead of both grids' (``benchmarks/bench_adhesive_bound.py``)
-    later = _in_background(solve, fine_grid)
+    later = in_background(lambda: solve(fine_grid), name="adhesive-check")
     coarse = solve(coarse_grid)
     fine = later()
     grids = [coarse_grid, fine_grid]
@@ -264,27 +262,3 @@ def bounded_check(
     )
     fine = replace(fine, notes=(*fine.notes, note))
     return BoundedCheck(fine, fine_grid, acc, tuple(grids), time.perf_counter() - start)
-
-
-def _in_background(fn: Callable[[int], AdhesiveSolved], arg: int) -> Callable[[], AdhesiveSolved]:
-    """``fn(arg)`` started on a daemon thread; the returned call waits for its result (or
-    raises its error). A daemon, so that an interrupt of the caller (Ctrl-C) ends the run
-    at once instead of waiting for this solve, as a pool's worker would."""
-    out: dict[str, object] = {}
-
-    def run() -> None:
-        try:
-            out["result"] = fn(arg)
-        except BaseException as exc:  # handed to the caller, which raises it
-            out["error"] = exc
-
-    thread = threading.Thread(target=run, name="adhesive-check", daemon=True)
-    thread.start()
-
-    def result() -> AdhesiveSolved:
-        thread.join()
-        if "error" in out:
-            raise out["error"]  # type: ignore[misc]
-        return out["result"]  # type: ignore[return-value]
-
-    return result
