@@ -40,8 +40,8 @@ from metainterface.physics.jkr import (
     jkr_force,
     jkr_indentation,
     jkr_radius,
-    power_coefficient,
 )
+from metainterface.physics.sneddon import log_kc
 
 #: Jacobi sweeps of the interaction (outer iterations, each a full set of JKR solves).
 ITERATIONS = 4
@@ -100,8 +100,12 @@ def adhesive_state(
     gap0 = d - hh  # (B, N, K)
     w_t = per_design(w, gamma)[:, None, None] if isinstance(w, Tensor) else w
     w_t = torch.as_tensor(w_t, dtype=gamma.dtype, device=gamma.device)
-    x_d = jkr_indentation(g, detach_radius(g, w_t, radius), w_t, radius)  # (B, N, 1), <= 0
-    reached = hh <= settings.delta_max * (1 + 1e-12)
+    # log kc once, with gamma's graph (its lgamma was most of a solve's cost, six times over)
+    lkc = log_kc(g, radius)
+    kc = torch.exp(lkc)
+    if unloading:
+        x_d = jkr_indentation(g, detach_radius(g, w_t, radius), w_t, radius)  # (B, N, 1), <= 0
+        reached = hh <= settings.delta_max * (1 + 1e-12)
 
     def in_contact(x: Tensor) -> Tensor:
         if unloading:
@@ -137,13 +141,14 @@ def adhesive_state(
             radius,
             self_coupling=self_k if coupled else None,
             start=raw,
+            log_coefficient=lkc,
         )
         # masked with where, not a product: 0^gamma has no gradient in gamma
-        force = torch.where(on, jkr_force(g, raw, w_t, radius), 0.0)
+        force = torch.where(on, jkr_force(g, raw, w_t, radius, coefficient=kc), 0.0)
         a = torch.where(on, raw, 0.0)
     # slopes along Delta, per asperity: dx/da and dF/da on the branch
     with torch.no_grad():
-        kc = power_coefficient(g, radius)
+        kc = kc.detach()
         s = flat_punch_coefficient(w_t, radius)
         safe = torch.where(on, a, torch.ones_like(a))
         pa = kc * safe**g

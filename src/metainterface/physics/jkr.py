@@ -77,19 +77,34 @@ def jkr_indentation(gamma: Tensor, a: Tensor, w: Tensor | float, radius: float =
     return kc * a**gamma - flat_punch_coefficient(w, radius) * torch.sqrt(a)
 
 
-def jkr_force(gamma: Tensor, a: Tensor, w: Tensor | float, radius: float = 1.0) -> Tensor:
-    """F / E* = 2 gamma/(gamma + 1) kc a^(gamma + 1) - sqrt(8 pi w R a^3) [length^2]."""
-    hertz = 2.0 * gamma / (gamma + 1.0) * power_coefficient(gamma, radius) * a ** (gamma + 1.0)
+def jkr_force(
+    gamma: Tensor,
+    a: Tensor,
+    w: Tensor | float,
+    radius: float = 1.0,
+    *,
+    coefficient: Tensor | None = None,
+) -> Tensor:
+    """F / E* = 2 gamma/(gamma + 1) kc a^(gamma + 1) - sqrt(8 pi w R a^3) [length^2].
+    coefficient: kc (``power_coefficient(gamma, radius)``) where the caller has it."""
+    kc = power_coefficient(gamma, radius) if coefficient is None else coefficient
+    hertz = 2.0 * gamma / (gamma + 1.0) * kc * a ** (gamma + 1.0)
     return hertz - 2.0 * flat_punch_coefficient(w, radius) * a * torch.sqrt(a)
 
 
-def touch_radius(gamma: Tensor, w: Tensor | float, radius: float = 1.0) -> Tensor:
-    """a0, the contact radius at zero indentation (snap-in at touch) [length]; 0 if w = 0."""
+def touch_radius(
+    gamma: Tensor,
+    w: Tensor | float,
+    radius: float = 1.0,
+    *,
+    log_coefficient: Tensor | None = None,
+) -> Tensor:
+    """a0, the contact radius at zero indentation (snap-in at touch) [length]; 0 if w = 0.
+    log_coefficient: log kc (``sneddon.log_kc(gamma, radius)``) where the caller has it."""
     w = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
     safe = torch.where(w > 0, w, torch.ones_like(w))
-    log_a0 = (0.5 * torch.log(2.0 * math.pi * radius * safe) - log_kc(gamma, radius)) / (
-        gamma - 0.5
-    )
+    lkc = log_kc(gamma, radius) if log_coefficient is None else log_coefficient
+    log_a0 = (0.5 * torch.log(2.0 * math.pi * radius * safe) - lkc) / (gamma - 0.5)
     return torch.where(w > 0, torch.exp(log_a0), torch.zeros_like(log_a0))
 
 
@@ -113,6 +128,7 @@ def jkr_radius(
     *,
     self_coupling: Tensor | None = None,
     start: Tensor | None = None,
+    log_coefficient: Tensor | None = None,
 ) -> Tensor:
     """Contact radius a [length] on the stable branch (a >= a_d) of delta(a) = x [length].
 
@@ -126,6 +142,8 @@ def jkr_radius(
     start: radii to start Newton from where they are on the stable branch (a root of a
     nearby x, e.g. the interaction's previous sweep); from the left of the root the first
     step lands right of it (convexity), so any start >= a_d converges.
+    log_coefficient: log kc (``sneddon.log_kc(gamma, radius)``, with gamma's graph) where
+    the caller has it (its lgamma is much of a call's cost; the result is the same).
     """
     w_t = torch.as_tensor(w, dtype=gamma.dtype, device=gamma.device)
 
@@ -146,10 +164,11 @@ def jkr_radius(
 
     with torch.no_grad():
         g0, x0, w0 = gamma.detach(), x.detach(), w_t.detach()
-        a_t = touch_radius(g0, w0, radius)
+        lk0 = log_kc(g0, radius) if log_coefficient is None else log_coefficient.detach()
+        a_t = touch_radius(g0, w0, radius, log_coefficient=lk0)
         a_d = a_t * (2.0 * g0) ** (-1.0 / (g0 - 0.5))
         # the coefficients once, not at every Newton step (lgamma is most of a step's cost)
-        kc = power_coefficient(g0, radius)
+        kc = torch.exp(lk0)
         s = flat_punch_coefficient(w0, radius)
         # numpy's: torch.broadcast_shapes runs through torch._refs, whose first call imports
         # sympy and torch.fx (0.3 s of a design's start)
@@ -182,8 +201,7 @@ def jkr_radius(
             a = a_new
     if not (gamma.requires_grad or x.requires_grad or w_t.requires_grad):
         return a
-    res, slope = residual(
-        a, gamma, x, power_coefficient(gamma, radius), flat_punch_coefficient(w_t, radius)
-    )
+    kc = power_coefficient(gamma, radius) if log_coefficient is None else torch.exp(log_coefficient)
+    res, slope = residual(a, gamma, x, kc, flat_punch_coefficient(w_t, radius))
     ok = slope.detach() > 0
     return a - torch.where(ok, res / torch.where(ok, slope.detach(), 1.0), 0.0)
