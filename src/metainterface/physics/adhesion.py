@@ -193,11 +193,9 @@ def sweep_adhesive(
         delta = delta_grid(settings, n_delta, dtype=gamma.dtype, device=gamma.device)
     st = adhesive_state(gamma, h, settings, w, delta, kernel=kernel, iterations=iterations)
     a_nom = settings.nominal_area
-    force = st.force.sum(1) / a_nom  # (B, K)
-    top = torch.cummax(torch.clamp_min(force, 0.0), dim=-1).values
+    force, top, on_branch, f_slope, load_slope = _rising(st, a_nom)
     k = force.shape[-1]
     index = torch.arange(k, device=force.device).expand_as(force)
-    on_branch = force >= top
     # the state the cell jumps to: the first sample at or after k back on the branch
     marks = torch.where(on_branch, index, torch.full_like(index, k - 1))
     jump = torch.flip(torch.cummin(torch.flip(marks, [-1]), dim=-1).values, [-1])
@@ -216,7 +214,6 @@ def sweep_adhesive(
     per_b = per.gather(-1, idx_b)
     per_j = (per_b + weight[:, None, :] * (per.gather(-1, idx_j) - per_b)).permute(0, 2, 1)
     alpha = per_j.sum(-1)
-    f_slope = st.force_slope.sum(1) / a_nom
     a_slope = st.area_slope.sum(1) / a_nom
     slope_j = f_slope.gather(-1, jump)
     area_j = a_slope.gather(-1, jump)
@@ -224,10 +221,39 @@ def sweep_adhesive(
     stiffness = torch.where(
         (area_j > 0) & ~flat, slope_j / torch.where(area_j > 0, area_j, 1.0), 0.0
     )
-    load_slope = torch.where(flat, 0.0, f_slope).detach()
     return Sweep(
         delta=delta, p_star=top, alpha=alpha, stiffness=stiffness, load_slope=load_slope
     ), per_j
+
+
+def _rising(st: AdhesiveState, a_nom: float) -> tuple[Tensor, Tensor, Tensor, Tensor, Tensor]:
+    """The cell's force (B, K) [P*] from its asperities' state, its running maximum (floored
+    at 0: P* of the rising force), whether each sample is on it, the force's slope along
+    Delta, and that slope where P* rises (0 where flat; detached)."""
+    force = st.force.sum(1) / a_nom  # (B, K)
+    top = torch.cummax(torch.clamp_min(force, 0.0), dim=-1).values
+    on_branch = force >= top
+    f_slope = st.force_slope.sum(1) / a_nom
+    return force, top, on_branch, f_slope, torch.where(on_branch, f_slope, 0.0).detach()
+
+
+def adhesive_load(
+    gamma: Tensor,
+    h: Tensor,
+    settings: CellSettings,
+    w: float | Tensor,
+    *,
+    delta: Tensor,
+    kernel: Tensor | None = None,
+    iterations: int = ITERATIONS,
+) -> Sweep:
+    """P* and its slope along Delta of :func:`sweep_adhesive` at the approaches ``delta``
+    (K,) or (B, K), the same values, without the rest (alpha and S* are zeros, not to be
+    used): the Newton steps of ``pressures.solve_delta`` read these alone."""
+    st = adhesive_state(gamma, h, settings, w, delta, kernel=kernel, iterations=iterations)
+    _, top, _, _, load_slope = _rising(st, settings.nominal_area)
+    zeros = torch.zeros_like(top)
+    return Sweep(delta=delta, p_star=top, alpha=zeros, stiffness=zeros, load_slope=load_slope)
 
 
 def touch_grid(h: Tensor, settings: CellSettings, n_delta: int) -> Tensor:

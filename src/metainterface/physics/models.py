@@ -283,8 +283,14 @@ class ForwardModel(ABC):
         """``load(delta=...)``: P* and ``load_slope`` of (B, N) designs at Deltas (B, M), for
         the Newton steps of ``pressures.solve_delta``; the sweep unless a model has less.
         With adhesion, a ``PathLoad``: its first brackets hold no snap-in."""
-        load = functools.partial(self.sweep, gamma, h, settings)
-        return jkr.PathLoad(load, h, settings) if self.adhesion else load
+        if not self.adhesion:
+            return functools.partial(self.sweep, gamma, h, settings)
+        # P* and its slope alone: a fifth of an adhesive sweep's operations are its alpha's
+        kernel = self.adhesion_kernel(settings, gamma.dtype, gamma.device)
+        load = functools.partial(
+            jkr.adhesive_load, gamma, h, settings, self.adhesion, kernel=kernel, **self._jkr_opts()
+        )
+        return jkr.PathLoad(load, h, settings)
 
     def alpha_at_loads(
         self,
