@@ -35,14 +35,13 @@ from pathlib import Path
 import numpy as np
 
 import metainterface as mi
+from _held_back import W_J, E, R, write_law
 from metainterface._testing import adhesive_cell_curve, held_back_cell
 from metainterface._threads import uses_threads
 from metainterface.validation.adhesive_path import APPROACHES_PER_LOAD, approaches, jkr_path
 from metainterface.validation.heightmap import height_map
 from metainterface.verify.check import bem_check
 
-E, R, W_J = 2.4e6, 0.5e-3, 0.05
-TAU, AREA = 0.3e6, 4e-4
 # Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
 QUICK = "--grid 96"
 
@@ -116,13 +115,8 @@ def restarts(design: mi.Design, target: mi.Target, model: mi.Independent, grid: 
 
 def whole_design(busy_count: int) -> None:
     """``metainterface design`` of the seed-11 cell's law, in a fresh process, timed."""
-    p, a = adhesive_cell_curve(W_J / (E * R), seed=11, rows=24)
     with tempfile.TemporaryDirectory() as tmp:
-        law = Path(tmp) / "law.csv"
-        rows = zip(p * AREA * E, a * TAU * AREA, strict=True)
-        law.write_text(
-            "normal_force,friction_force\n" + "".join(f"{x:.12g},{y:.12g}\n" for x, y in rows)
-        )
+        law = write_law(Path(tmp) / "law.csv", seed=11)
         argv = [
             sys.executable, "-m", "metainterface", "design", "--friction-csv", str(law),
             "--shear-strength", "0.3MPa", "--modulus", "2.4MPa", "--radius", "0.5mm",

@@ -20,11 +20,8 @@ from pathlib import Path
 import numpy as np
 
 import metainterface as mi
-from metainterface._testing import adhesive_cell_curve
+from _held_back import AREA, TAU, E, R, write_law
 from metainterface.verify.check import bem_check
-
-E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
-
 
 # Quick mode (`python benchmarks/run.py run --quick`, CI): seconds, same code paths.
 QUICK = "--grids 48 --zero-shot"
@@ -35,12 +32,7 @@ def main() -> None:
     ap.add_argument("--grids", type=int, nargs="+", default=[96, 192])
     ap.add_argument("--zero-shot", action="store_true", help="the design before refinement")
     args = ap.parse_args()
-    p, a = adhesive_cell_curve(W_J / (E * R), seed=11, rows=24)
-    path = Path(tempfile.mkdtemp()) / "pdms.csv"
-    rows = zip(p * AREA * E, a * TAU * AREA, strict=True)
-    path.write_text(
-        "normal_force,friction_force\n" + "".join(f"{x:.12g},{y:.12g}\n" for x, y in rows)
-    )
+    path = write_law(Path(tempfile.mkdtemp()) / "pdms.csv", seed=11)
     scale = dict(shear_strength=TAU, modulus=E, radius=R, area=AREA, fit="never")
     target = mi.Target.from_friction(path, work_of_adhesion="50mJ/m2", **scale)
     with warnings.catch_warnings():

@@ -35,9 +35,9 @@ import warnings
 from pathlib import Path
 
 import metainterface as mi
+from _held_back import AREA, TAU, W_J, E, R, write_law
 from metainterface._testing import adhesive_cell_curve, held_back_cell
 
-E, R, W_J, TAU, AREA = 2.4e6, 0.5e-3, 0.05, 0.3e6, 4e-4
 #: Laws the offset polish's settings and the adhesive fallback threshold were chosen on.
 TUNED_ON = range(11, 31)
 #: Laws none of those settings was chosen on: ``--held-out`` designs these.
@@ -143,12 +143,7 @@ def design_law(
     """The held-back law of ``seed`` (its cell's loading curve, 24 rows, as a friction law
     over ``AREA``) written to ``folder`` and designed with ``tau`` [Pa] and ``work``
     [J/m^2]: at ``AREA``, or with the area designed too (``area_auto``)."""
-    p, a = adhesive_cell_curve(W_J / (E * R), seed=seed, rows=24)
-    path = folder / f"law{seed}.csv"
-    path.write_text(
-        "normal_force,friction_force\n"
-        + "".join(f"{x:.12g},{y:.12g}\n" for x, y in zip(p * AREA * E, a * TAU * AREA, strict=True))
-    )
+    path = write_law(folder / f"law{seed}.csv", seed)
     units = dict(shear_strength=tau, modulus=E, radius=R, work_of_adhesion=work, fit="never")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
