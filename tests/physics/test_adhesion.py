@@ -321,8 +321,10 @@ def test_sweep_gradients_finite():
         g.grad = h.grad = None
 
 
-@pytest.mark.parametrize("seed", [13, 30, 42, 49])
-def test_exact_loads_are_the_rising_force_path(seed):
+@pytest.mark.parametrize(
+    ("seed", "interacting"), [(13, False), (30, False), (42, False), (49, False), (13, True)]
+)
+def test_exact_loads_are_the_rising_force_path(seed, interacting):
     """alpha at given loads by Newton (``alpha_at(exact=True)``: the design's error, F_0, the
     polish) against the loading path read another way: a sweep on 65537 approaches with a
     knot at every touch, interpolated at the loads, no Newton. Where a touch falls between
@@ -332,7 +334,8 @@ def test_exact_loads_are_the_rising_force_path(seed):
     from metainterface.physics.metrics import interp
 
     s = CellSettings()
-    model = mi.Independent(adhesion=W)
+    # the interacting model's Newton steps read its own load (``newton_load``) too
+    model = mi.Interacting(adhesion=W) if interacting else mi.Independent(adhesion=W)
     rng = np.random.default_rng(seed)
     g = torch.as_tensor(rng.uniform(1.8, 4.0, 9))[None]
     h = rng.uniform(0, 0.6, 9) * s.delta_max
