@@ -231,3 +231,38 @@ def test_a_restarted_state_of_a_cell_is_the_continued_one_within_a_ring():
         )
         np.testing.assert_array_equal(split.touching, full.touching)
         assert (np.abs(split.alpha - full.alpha) * m * m <= ring).all()
+
+
+def test_a_chain_that_fails_stops_the_other(monkeypatch):
+    # where the restarted chain's first solve fails, the error is the path's, and the
+    # other chain starts at most the state it was about to start (no work left running)
+    import threading
+
+    from metainterface.errors import MetainterfaceError
+    from metainterface.validation import adhesive_path
+
+    design = Design(gamma=np.array([2.0]), h=np.array([0.0]), settings=CellSettings(n_asperities=1))
+    hm = height_map(design, 64)
+    approaches = np.linspace(0, 0.02, 41)[1:]
+    restart_gap = -float(hm.heights.mean()) - approaches[20]  # the mean gap of state 20
+    started, after = [], []
+    failed = threading.Event()
+    real = adhesive_path.solve_jkr
+
+    def solve(z, side, target, work, **kwargs):
+        if failed.is_set():
+            after.append(float(target[0]))
+        if abs(float(target[0]) - restart_gap) < 1e-9:  # the approaches are 5e-4 apart
+            failed.wait(timeout=0.2)  # the first chain is under way
+            failed.set()
+            raise MetainterfaceError("adhesive BEM (JKR) did not converge (test)")
+        started.append(float(target[0]))
+        if len(started) == 3:
+            failed.wait(timeout=5.0)  # the first chain is busy when the other fails
+        return real(z, side, target, work, **kwargs)
+
+    monkeypatch.setattr(adhesive_path, "solve_jkr", solve)
+    with pytest.raises(MetainterfaceError, match="did not converge"):
+        jkr_path(hm.heights, hm.cell_side, 4.2e-5, approaches, restart=20)
+    threading.Event().wait(0.5)  # time for a chain left running to start more states
+    assert len(started) < 20 and len(after) <= 1

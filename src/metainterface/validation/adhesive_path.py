@@ -15,6 +15,7 @@ of an adhesive design (``adhesive_validate``) read it.
 
 from __future__ import annotations
 
+import threading
 import time
 from dataclasses import dataclass
 
@@ -119,11 +120,13 @@ def _chain(
     own: torch.Tensor | None,
     n_owner: int,
     stop_above: float | None,
+    cancel: threading.Event | None = None,
 ) -> tuple[dict, bool]:
     """The states of one chain of approaches, each from the one before (the first from
     the rigid overlap): rising ``up`` until the first state above ``stop_above``, then
     ``down``; per-state lists and the last state's pressure (1, M, M), and whether the
-    loading stopped there."""
+    loading stopped there. ``cancel``: once set, no further state is solved (the states
+    so far are returned, for a caller that drops them)."""
     z_bar = -float(z.mean())
     contact = pressure = None
     out: dict = {k: [] for k in ("p_star", "alpha", "touching", "share", "p_max", "residual")}
@@ -147,6 +150,8 @@ def _chain(
 
     stopped = False
     for d in up:
+        if cancel is not None and cancel.is_set():
+            break
         solve(d)
         if stop_above is not None and out["p_star"][-1] > stop_above:
             stopped = True  # the loading ends here; the unloading (if any) goes on
@@ -175,12 +180,29 @@ def _chains(
     A restarted state is a loading state as well: the contact grows from the rigid overlap
     to the first stable set instead of from the state before, and the two differ only by
     where the grid pins the edge: a fraction of a ring of boundary points, well below the
-    check's own accuracy (``benchmarks/bench_adhesive_bound.py --restarts``)."""
-    first = in_background(
-        lambda: _chain(z, side, work, up[:restart], up[:0], own, n_owner, stop_above),
-        name="adhesive-path",
-    )
-    second, _ = _chain(z, side, work, up[restart:], up[:0], own, n_owner, stop_above)
+    check's own accuracy (``benchmarks/bench_adhesive_bound.py --restarts``).
+
+    Each chain stops the other where its work is no longer needed: the first where it
+    stops above ``stop_above`` (the second's states are dropped), either where it raises
+    (the error is raised here at once, not after the other chain's states)."""
+    cancel = threading.Event()
+
+    def chain(part: np.ndarray) -> tuple[dict, bool]:
+        try:
+            out = _chain(z, side, work, part, up[:0], own, n_owner, stop_above, cancel)
+        except BaseException:
+            cancel.set()
+            raise
+        return out
+
+    def first_chain() -> tuple[dict, bool]:
+        out = chain(up[:restart])
+        if out[1]:  # stopped above the load: the second chain is not needed
+            cancel.set()
+        return out
+
+    first = in_background(first_chain, name="adhesive-path")
+    second, _ = chain(up[restart:])
     states, stopped = first()
     if stopped:
         return states
