@@ -8,11 +8,12 @@ curve error weighs the zero-load row as one point of many; the design's note sta
 against the law's.
 
     PYTHONPATH=src python benchmarks/bench_offset_f0.py [--seeds 11 12 13] [--range 11 30]
-        [--held-out] [--zero-shot] [--area-auto] [--calibrated] [--verify]
+        [--held-out] [--zero-shot] [--area-auto] [--calibrated] [--verify] [--fallback N]
 
 Ends with the median and largest curve error and |F_0 error| over the laws (``--range A B``:
 the seeds A..B). ``--zero-shot``: the design before its refinement, as
 ``bench_friction_laws.py`` measures it (``Effort(refine=False, hedge=0, fallback=0)``).
+``--fallback N``: the adhesive fallback's multistart with N starts (0: without it).
 ``--area-auto`` (issue 52): the area designed with the cell (``design_scale(area="auto")``,
 as ``design --area auto``). ``--calibrated``: tau and w as a sphere test read them (a
 synthetic JKR test of the true tau and w, 25 rows from a pull to 20 mN, 3 % scatter,
@@ -69,8 +70,13 @@ def main() -> None:
     ap.add_argument("--area-auto", action="store_true", help="design the area too")
     ap.add_argument("--calibrated", action="store_true", help="tau, w from a sphere test")
     ap.add_argument("--verify", action="store_true", help="with the BEM check, as design runs")
+    ap.add_argument(
+        "--fallback", type=int, default=None, help="the fallback multistart's starts (0: none)"
+    )
     args = ap.parse_args()
     quick = {"refine": False, "hedge": 0, "fallback": 0} if args.zero_shot else {}
+    if args.fallback is not None:
+        quick["fallback"] = args.fallback
     effort = mi.Effort(seed=0, **quick)
     if args.range:
         args.seeds = list(range(args.range[0], args.range[1] + 1))
