@@ -212,8 +212,9 @@ def test_design_interrupted_writes_all_or_nothing(tmp_path, sig):
     names = sorted(p.name for p in out.iterdir()) if out.exists() else []
     assert names in ([], ["curve.csv", "design.json", "design.png"]), names
     if names:  # the run finished first: a signal during the interpreter's shutdown, after
-        # the files were whole, ends it with the default action (a loaded machine's timing)
-        assert rc in (0, -sig), rc
+        # the files were whole, ends it with the default action (a loaded machine's timing);
+        # one during the set's renames is held back and raised after them (130)
+        assert rc in (0, -sig, 130), rc
     elif rc != 0:
         assert rc == 130
         assert proc.stderr.read().strip().endswith("interrupted")

@@ -8,6 +8,11 @@ any exception (SIGINT, and SIGTERM once :func:`terminate_as_interrupt` is instal
 process killed outright (SIGKILL) cannot clean up, so every later write into the same folder
 removes the temporaries of processes that no longer exist (:func:`sweep_stale`).
 
+An interrupt can land between any two bytecodes, so each temporary's name is recorded
+before the file is made (an interrupt in between leaves nothing to find), and a set's
+renames run with SIGINT/SIGTERM/SIGHUP held back (:func:`_held_interrupts`): the set goes out
+whole and the interrupt is raised after.
+
 Only regular files are ever replaced: a symlink, FIFO, device or folder under the target's
 name is refused with a one-line error, so ``--out /dev/stdout`` cannot clobber anything.
 """
@@ -17,10 +22,10 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import secrets
 import shutil
 import signal
 import stat
-import tempfile
 import threading
 from collections.abc import Iterator
 from pathlib import Path
@@ -130,23 +135,66 @@ def _file_ancestor(path: Path) -> Path | None:
     return None
 
 
+def _raise_interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
+_HELD = (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", signal.SIGTERM))
+
+
+@contextlib.contextmanager
+def _held_interrupts() -> Iterator[None]:
+    """Inside the block, a signal that would raise KeyboardInterrupt (SIGINT's default
+    handler, :func:`terminate_as_interrupt`'s) is held back and raised when the block ends;
+    signals with any other handler are left alone. Main thread only (others never see them)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending: list[str] = []
+
+    def hold(signum: int, frame: Any) -> None:
+        pending.append(signal.Signals(signum).name)
+
+    previous = {}
+    try:
+        for sig in dict.fromkeys(_HELD):
+            old = signal.getsignal(sig)
+            if old is signal.default_int_handler or old is _raise_interrupt:
+                previous[sig] = old
+                signal.signal(sig, hold)
+        yield
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+    if pending:
+        raise KeyboardInterrupt(pending[0])
+
+
 class _Set:
-    """Temporaries written so far, each with its final name, and folders made for them."""
+    """Temporaries written so far, each with its final name; every temporary made (named
+    before it is made), and folders made for them."""
 
     def __init__(self) -> None:
         self.staged: dict[Path, str] = {}
+        self.temps: list[str] = []
         self.made: list[Path] = []
 
     def commit(self) -> None:
-        for path, tmp in self.staged.items():
-            os.replace(tmp, path)
-        self.staged.clear()
+        with _held_interrupts():  # every rename, or (before the first) none
+            for path, tmp in self.staged.items():
+                os.replace(tmp, path)
+            self.staged.clear()
+        self._remove_temps()  # files written twice: the earlier ones
 
-    def rollback(self) -> None:
-        for tmp in self.staged.values():
+    def _remove_temps(self) -> None:
+        for tmp in self.temps:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(tmp)
+        self.temps.clear()
+
+    def rollback(self) -> None:
         self.staged.clear()
+        self._remove_temps()
         for folder in reversed(self.made):  # only folders this set made, only when empty
             with contextlib.suppress(OSError):
                 folder.rmdir()
@@ -191,10 +239,19 @@ def ensure_parent(path: str | os.PathLike[str]) -> Path:
     return path
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
+def _temporary(path: Path) -> str:
+    """A fresh temporary's name beside ``path`` (made by :func:`_create`)."""
+    return os.path.join(path.parent, f".{path.name}.mi-{os.getpid()}-{secrets.token_hex(8)}.tmp")
+
+
+def _create(tmp: str, path: Path) -> int:
+    """Make the temporary ``tmp`` (only if new) and open it for writing; mode 0666 less the
+    umask, as ``open`` makes files."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
+    try:
+        return os.open(tmp, flags, 0o666)
+    except OSError as exc:
+        raise MetainterfaceError(f"cannot write {path}: {exc.strerror}") from None
 
 
 @contextlib.contextmanager
@@ -204,19 +261,12 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", **kwargs: Any) ->
     with output_set():
         path = ensure_parent(path)
         sweep_stale(path.parent)
-        try:
-            fd, tmp = tempfile.mkstemp(
-                prefix=f".{path.name}.mi-{os.getpid()}-", suffix=".tmp", dir=path.parent
-            )
-        except OSError as exc:
-            raise MetainterfaceError(f"cannot write {path}: {exc.strerror}") from None
         current: _Set = _local.set
-        old = current.staged.pop(path, None)
-        if old is not None:  # written twice in one set: the later one wins
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(old)
+        tmp = _temporary(path)
+        current.temps.append(tmp)  # before the file exists: the set removes it on any error
+        fd = _create(tmp, path)
+        current.staged.pop(path, None)  # written twice in one set: the later one wins
         current.staged[path] = tmp
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; outputs follow the umask
         try:
             with os.fdopen(fd, mode, **kwargs) as fh:
                 yield fh
@@ -235,13 +285,9 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """A temporary path beside ``path`` for a library that writes by file name; on success
     it replaces ``path`` in one rename."""
     path = ensure_parent(path)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    except OSError as exc:
-        raise MetainterfaceError(f"cannot write {path}: {exc.strerror}") from None
-    os.close(fd)
-    try:
-        os.chmod(tmp, 0o666 & ~_umask())
+    tmp = _temporary(path)
+    try:  # from before the file exists, so that an interrupt cannot leave it behind
+        os.close(_create(tmp, path))
         yield Path(tmp)
         os.replace(tmp, path)
     except BaseException:
@@ -270,13 +316,12 @@ def terminate_as_interrupt() -> Iterator[None]:
     SIGINT does, so that every temporary is removed on the way out; the previous handlers
     come back after. For entry points (the command line)."""
 
-    def handler(signum: int, frame: Any) -> None:
-        raise KeyboardInterrupt(signal.Signals(signum).name)
-
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    previous = {
+        sig: signal.signal(sig, _raise_interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)
+    }
     try:
         yield
     finally:
