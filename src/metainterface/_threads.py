@@ -31,7 +31,7 @@ import sys
 import threading
 import warnings
 from collections.abc import Callable, Iterator
-from typing import Any, Literal, TypeVar
+from typing import Any, Generic, Literal, TypeVar
 
 #: The environment variables through which a user chooses torch's thread count.
 USER_ENV = ("OMP_NUM_THREADS", "MKL_NUM_THREADS")
@@ -166,27 +166,71 @@ def uses_threads(work: Work = "light") -> Callable[[F], F]:
 
 T = TypeVar("T")
 
+_stops = threading.local()
 
-def in_background(fn: Callable[[], T], name: str) -> Callable[[], T]:
+
+class _Stop:
+    """A request to stop: this thread's own, or that of the thread that started it."""
+
+    def __init__(self, parent: _Stop | None) -> None:
+        self.event = threading.Event()
+        self.parent = parent
+
+    def is_set(self) -> bool:
+        return self.event.is_set() or (self.parent is not None and self.parent.is_set())
+
+
+def stop_asked() -> bool:
+    """Whether the work on this thread is no longer wanted: the caller of its
+    :func:`in_background` (or theirs) gave up on it. Loops of long steps end early on it."""
+    stop = getattr(_stops, "stop", None)
+    return stop is not None and stop.is_set()
+
+
+class Background(Generic[T]):
+    """``fn()`` running on a daemon thread (:func:`in_background`). Call it for the result
+    (or its error); :meth:`stop` says it is no longer wanted (:func:`stop_asked` on that
+    thread and the threads it starts). As a context manager, leaving the block by an error
+    (an interrupt too) stops it."""
+
+    def __init__(self, fn: Callable[[], T], name: str) -> None:
+        self._out: dict[str, Any] = {}
+        self._stop = _Stop(getattr(_stops, "stop", None))
+        self._thread = threading.Thread(target=self._run, args=(fn,), name=name, daemon=True)
+        self._thread.start()
+
+    def _run(self, fn: Callable[[], T]) -> None:
+        _stops.stop = self._stop
+        try:
+            self._out["result"] = fn()
+        except BaseException as exc:  # handed to the caller, which raises it
+            self._out["error"] = exc
+
+    def stop(self) -> None:
+        self._stop.event.set()
+
+    def __call__(self) -> T:
+        try:
+            self._thread.join()
+        except BaseException:  # an interrupt while waiting: the work is not wanted
+            self.stop()
+            raise
+        if "error" in self._out:
+            raise self._out["error"]
+        return self._out["result"]
+
+    def __enter__(self) -> Background[T]:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, *rest: Any) -> None:
+        if kind is not None:
+            self.stop()
+
+
+def in_background(fn: Callable[[], T], name: str) -> Background[T]:
     """``fn()`` started on a daemon thread ``name``; the returned call waits for its result
     (or raises its error). For torch work that releases the GIL (FFTs, conjugate-gradient
     steps) beside the caller's own. A daemon, so that an interrupt of the caller (Ctrl-C)
-    ends the run at once instead of waiting for it, as a pool's worker would."""
-    out: dict[str, Any] = {}
-
-    def run() -> None:
-        try:
-            out["result"] = fn()
-        except BaseException as exc:  # handed to the caller, which raises it
-            out["error"] = exc
-
-    thread = threading.Thread(target=run, name=name, daemon=True)
-    thread.start()
-
-    def result() -> T:
-        thread.join()
-        if "error" in out:
-            raise out["error"]
-        return out["result"]
-
-    return result
+    ends the run at once instead of waiting for it, as a pool's worker would; the work
+    itself ends at its next :func:`stop_asked` (use the result as a context manager)."""
+    return Background(fn, name)

@@ -150,3 +150,35 @@ def test_two_grids_with_one_snap_in_sampled_apart_agree():
         np.array([[1.2e-3, 1.3e-3]]),
     )
     assert accuracy(fine, late, target) > 0.05
+
+
+def test_a_check_whose_coarse_grid_fails_stops_its_fine_grid(hertz, monkeypatch):
+    # the two grids run at once; where the coarse one fails, the error is the check's and
+    # the fine grid (both its chains) starts at most the states it was about to start
+    import threading
+
+    from metainterface.validation import adhesive_path
+    from metainterface.verify import bem_check
+
+    design, target = hertz
+    real = adhesive_path.solve_jkr
+    busy, failed = threading.Event(), threading.Event()
+    fine_started, fine_after = [], []
+
+    def solve(z, side, gap, work, **kwargs):
+        if z.shape[-1] == 32:  # the coarse grid fails once the fine grid is under way
+            busy.wait(timeout=5.0)
+            failed.set()
+            raise mi.MetainterfaceError("adhesive BEM (JKR) did not converge (test)")
+        (fine_after if failed.is_set() else fine_started).append(float(gap[0]))
+        if len(fine_started) == 2 and not failed.is_set():
+            busy.set()
+            failed.wait(timeout=5.0)  # the fine grid is mid-state when the coarse one fails
+        return real(z, side, gap, work, **kwargs)
+
+    monkeypatch.setattr(adhesive_path, "solve_jkr", solve)
+    model = mi.Independent(adhesion=W)
+    with pytest.raises(mi.MetainterfaceError, match="did not converge"):
+        bem_check(design, target, mi.Verify(grid=64, loads=8), model)
+    threading.Event().wait(1.0)  # time for a grid left running to solve its other states
+    assert len(fine_started) >= 2 and len(fine_after) <= 2, (fine_started, fine_after)

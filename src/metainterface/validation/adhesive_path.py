@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from metainterface._threads import in_background
+from metainterface._threads import in_background, stop_asked
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
@@ -125,8 +125,9 @@ def _chain(
     """The states of one chain of approaches, each from the one before (the first from
     the rigid overlap): rising ``up`` until the first state above ``stop_above``, then
     ``down``; per-state lists and the last state's pressure (1, M, M), and whether the
-    loading stopped there. ``cancel``: once set, no further state is solved (the states
-    so far are returned, for a caller that drops them)."""
+    loading stopped there. ``cancel``: once set (or once this thread's caller gives up on
+    it, ``stop_asked``), no further state is solved (the states so far are returned, for a
+    caller that drops them)."""
     z_bar = -float(z.mean())
     contact = pressure = None
     out: dict = {k: [] for k in ("p_star", "alpha", "touching", "share", "p_max", "residual")}
@@ -148,15 +149,20 @@ def _chain(
             out["share"].append((hits / own.numel()).cpu().numpy())
         out["seconds"].append(time.perf_counter() - start)
 
+    def wanted() -> bool:  # neither the other chain nor the caller gave up on these states
+        return not (cancel is not None and cancel.is_set()) and not stop_asked()
+
     stopped = False
     for d in up:
-        if cancel is not None and cancel.is_set():
+        if not wanted():
             break
         solve(d)
         if stop_above is not None and out["p_star"][-1] > stop_above:
             stopped = True  # the loading ends here; the unloading (if any) goes on
             break
     for d in down:
+        if not wanted():
+            break
         solve(d)
     out["pressure"] = pressure
     return out, stopped
@@ -201,9 +207,9 @@ def _chains(
             cancel.set()
         return out
 
-    first = in_background(first_chain, name="adhesive-path")
-    second, _ = chain(up[restart:])
-    states, stopped = first()
+    with in_background(first_chain, name="adhesive-path") as first:
+        second, _ = chain(up[restart:])
+        states, stopped = first()
     if stopped:
         return states
     return {k: (second[k] if k == "pressure" else states[k] + second[k]) for k in second}

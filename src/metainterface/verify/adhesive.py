@@ -233,9 +233,9 @@ def bounded_check(
     # and CG steps release the GIL), each path in two chains (``rising_branch``): on two
     # cores, or beside busy processes, the check takes about half the fine path's time
     # instead of both grids' (``benchmarks/bench_adhesive_bound.py``)
-    later = in_background(lambda: solve(fine_grid), name="adhesive-check")
-    coarse = solve(coarse_grid)
-    fine = later()
+    with in_background(lambda: solve(fine_grid), name="adhesive-check") as later:
+        coarse = solve(coarse_grid)  # where it fails, the fine grid stops at its next state
+        fine = later()
     grids = [coarse_grid, fine_grid]
     acc = accuracy(fine, coarse, target)
     bound = BOUND_SHARE * max_error
