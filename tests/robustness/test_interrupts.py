@@ -47,8 +47,8 @@ with terminate_as_interrupt():
         folder = root / f"run{i}"
         done.clear()
         delay[0] = rng.uniform(0.0, 0.0015)
-        go.set()
         try:
+            go.set()  # inside: a signal at once is this run's interrupt too
             with output_set():
                 write_text(folder / "curve.csv", "p_star,alpha\n" * 50)
                 write_bytes(folder / "design.png", bytes(2000))
