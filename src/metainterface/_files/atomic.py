@@ -265,8 +265,7 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", **kwargs: Any) ->
         tmp = _temporary(path)
         current.temps.append(tmp)  # before the file exists: the set removes it on any error
         fd = _create(tmp, path)
-        current.staged.pop(path, None)  # written twice in one set: the later one wins
-        current.staged[path] = tmp
+        current.staged[path] = tmp  # written twice in one set: the later one wins
         try:
             with os.fdopen(fd, mode, **kwargs) as fh:
                 yield fh

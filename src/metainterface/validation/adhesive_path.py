@@ -191,24 +191,21 @@ def _chains(
     Each chain stops the other where its work is no longer needed: the first where it
     stops above ``stop_above`` (the second's states are dropped), either where it raises
     (the error is raised here at once, not after the other chain's states)."""
-    cancel = threading.Event()
+    cancel = threading.Event()  # set by the first chain: the second's states are not needed
 
-    def chain(part: np.ndarray) -> tuple[dict, bool]:
+    def first_chain() -> tuple[dict, bool]:
         try:
-            out = _chain(z, side, work, part, up[:0], own, n_owner, stop_above, cancel)
+            out = _chain(z, side, work, up[:restart], up[:0], own, n_owner, stop_above)
         except BaseException:
             cancel.set()
             raise
-        return out
-
-    def first_chain() -> tuple[dict, bool]:
-        out = chain(up[:restart])
         if out[1]:  # stopped above the load: the second chain is not needed
             cancel.set()
         return out
 
+    # leaving the block by the second chain's error stops the first (``Background``)
     with in_background(first_chain, name="adhesive-path") as first:
-        second, _ = chain(up[restart:])
+        second, _ = _chain(z, side, work, up[restart:], up[:0], own, n_owner, stop_above, cancel)
         states, stopped = first()
     if stopped:
         return states
