@@ -225,12 +225,17 @@ class Background(Generic[T]):
     def __exit__(self, kind: type[BaseException] | None, *rest: Any) -> None:
         if kind is not None:
             self.stop()
+            # and wait for it to end at its next stop_asked() (one step): a process that
+            # exits while a daemon thread is inside torch aborts ("terminate called without
+            # an active exception", status 134) instead of exiting with its own status
+            self._thread.join()
 
 
 def in_background(fn: Callable[[], T], name: str) -> Background[T]:
     """``fn()`` started on a daemon thread ``name``; the returned call waits for its result
     (or raises its error). For torch work that releases the GIL (FFTs, conjugate-gradient
     steps) beside the caller's own. A daemon, so that an interrupt of the caller (Ctrl-C)
-    ends the run at once instead of waiting for it, as a pool's worker would; the work
-    itself ends at its next :func:`stop_asked` (use the result as a context manager)."""
+    need not wait for the whole work, as a pool's worker's would; used as a context manager,
+    the block left by an error stops the work and waits for it to end at its next
+    :func:`stop_asked`, so that the process exits with its own status."""
     return Background(fn, name)

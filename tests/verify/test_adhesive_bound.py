@@ -182,3 +182,33 @@ def test_a_check_whose_coarse_grid_fails_stops_its_fine_grid(hertz, monkeypatch)
         bem_check(design, target, mi.Verify(grid=64, loads=8), model)
     threading.Event().wait(1.0)  # time for a grid left running to solve its other states
     assert len(fine_started) >= 2 and len(fine_after) <= 2, (fine_started, fine_after)
+
+
+def test_a_failed_check_exits_with_its_own_status_not_an_abort(tmp_path):
+    # the coarse grid (32^2) of a strongly adhesive Hertz asperity reaches no state in the
+    # target's range and raises while the fine grid still solves on its own thread: the
+    # process that then exits must not abort inside torch ("terminate called ...", 134)
+    script = tmp_path / "fails.py"
+    script.write_text(
+        "import sys\n"
+        "import numpy as np\n"
+        "import metainterface as mi\n"
+        "from metainterface.physics import CellSettings\n"
+        "from metainterface.verify import bem_check\n"
+        "d = mi.Design(gamma=np.array([2.0]), h=np.array([0.0]),\n"
+        "              settings=CellSettings(n_asperities=1))\n"
+        "model = mi.Independent(adhesion=1e-3)\n"
+        "top = float(model.model_curve(d).p_star_max)\n"
+        "t = mi.Target(p_star=np.linspace(0, top, 20), alpha=np.linspace(0.01, 0.2, 20))\n"
+        "try:\n"
+        "    bem_check(d, t, mi.Verify(grid=64, loads=10), model)\n"
+        "except mi.MetainterfaceError as exc:\n"
+        "    print(exc, file=sys.stderr)\n"
+        "    sys.exit(2)\n"
+    )
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True)
+    assert run.returncode == 2, run.stderr
+    assert "reached no load" in run.stderr and "terminate" not in run.stderr
