@@ -179,3 +179,19 @@ def test_a_negative_quantity_is_told_its_range(tmp_path, capsys, option, value, 
     err = capsys.readouterr().err
     assert message in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
+
+
+def test_an_adhesive_check_finer_than_the_bem_allows_is_refused_before_any_work(tmp_path, capsys):
+    """An adhesive design's check refuses a grid above 256 points per asperity (its error
+    stops falling there and its estimate no longer holds: bench_adhesive_convergence.py),
+    at once, with the range, nothing written; the adhesionless check takes the same grid."""
+    csv = tmp_path / "law.csv"
+    csv.write_text("normal_force,friction_force\n" + "".join(f"{f},{6 * f}\n" for f in range(1, 6)))
+    argv = ["design", "--friction-csv", str(csv), "--area", "auto", "--out", str(tmp_path / "o")]
+    argv += ["--shear-strength", "0.3MPa", "--modulus", "2.4MPa", "--radius", "0.5mm"]
+    argv += ["--work-of-adhesion", "50mJ/m2", "--verify-grid", "1536"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--verify-grid must be at most 768" in err, err
+    assert len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()

@@ -17,20 +17,24 @@ from metainterface.verify.adhesive import bounded_check, solve_adhesive
 W = 4.2e-5  # w / (E* R): PDMS on glass at R = 0.5 mm
 
 
-@pytest.fixture(scope="module")
-def hertz():
+def _jkr(work: float):
     """A Hertz asperity (gamma = 2) and its JKR loading curve as the target, from the JKR
     closed form written here (F = P* L^2, R = 1, E* = 1)."""
     d = mi.Design(gamma=np.array([2.0]), h=np.array([0.0]), settings=CellSettings(n_asperities=1))
     from metainterface.validation.heightmap import height_map
 
     side = height_map(d, 16).cell_side
-    top = float(mi.Independent(adhesion=W).model_curve(d).p_star_max)
+    top = float(mi.Independent(adhesion=work).model_curve(d).p_star_max)
     p = np.linspace(0, top, 64)[1:]
     f = p * side**2
-    q = 3 * math.pi * W
-    a = ((f + q + np.sqrt(6 * math.pi * W * f + q * q)) / (4 / 3)) ** (1 / 3)
+    q = 3 * math.pi * work
+    a = ((f + q + np.sqrt(6 * math.pi * work * f + q * q)) / (4 / 3)) ** (1 / 3)
     return d, mi.Target(p_star=p, alpha=math.pi * a * a / side**2, name="hertz")
+
+
+@pytest.fixture(scope="module")
+def hertz():
+    return _jkr(W)
 
 
 def _error(alpha, p, target):
@@ -212,3 +216,26 @@ def test_a_failed_check_exits_with_its_own_status_not_an_abort(tmp_path):
     run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True)
     assert run.returncode == 2, run.stderr
     assert "reached no load" in run.stderr and "terminate" not in run.stderr
+
+
+def test_an_adhesive_validation_finer_than_the_bem_allows_is_refused(hertz):
+    # above 256 points per asperity the JKR-limit BEM's error against JKR stops falling (and
+    # grows with strong adhesion): bench_adhesive_convergence.py
+    design, _ = hertz
+    with pytest.raises(mi.MetainterfaceError, match="grid must be at most 256") as info:
+        mi.validate(design, model=mi.Independent(adhesion=W), grid=512)
+    assert info.value.argument == "grid"
+
+
+@pytest.mark.long
+@pytest.mark.parametrize("work", [2e-5, 1e-4, 2e-4, 5e-4])
+def test_the_bound_holds_against_jkr_at_the_finest_grid_the_check_takes(work):
+    # 256 points per asperity (adhesive_path.FINEST): past it the estimate no longer holds
+    # (bench_adhesive_convergence.py); the JKR closed form written here, not the model's
+    from metainterface.validation.adhesive_path import FINEST
+
+    d, target = _jkr(work)
+    b = bounded_check(
+        d, target, mi.Independent(adhesion=work), grid=FINEST, loads=10, max_error=0.02
+    )
+    assert 0 < _error(b.solved.alpha_bem, b.solved.p_star, target) <= b.accuracy

@@ -221,7 +221,7 @@ def designed(
         raise MetainterfaceError(f"full_target must be True or False, got {full_target!r}")
     checks = as_verify(verify, device)
     if checks is not None:  # a bad grid or device fails now, not after the design
-        checks.ready(settings or CellSettings())
+        checks.ready(settings or CellSettings(), adhesive=bool(fm.adhesion))
     limit = _limit(max_pressure, modulus)
     extra_loss = None
     if limit is not None:

@@ -41,7 +41,11 @@ flat punch (it comes off at Kendall's F = sqrt(8 pi w E* a^3)), see
 ``adhesive_edge.pull_off_factor``, and c_g follows from the crack's opening; the JKR sphere
 is then an independent check: a Hertz asperity's contact fraction against the JKR a(P) at
 each compressive force, loading and unloading, falls with the grid (the edge is placed to a
-fraction of a spacing; benchmarks/results/adhesion.md).
+fraction of a spacing; benchmarks/results/adhesion.md) up to about 256 points per cell side.
+Past that it does not: both thresholds are pixel-scale constants, an edge pinned between
+them sits within a share of K_c that the grid does not shrink, and a rising force's edge
+lags JKR's at low loads (``benchmarks/bench_adhesive_convergence.py``;
+``adhesive_path.FINEST`` caps the check's and validation's grids there).
 
 Everything is float64 (but the JKR preconditioner, above) and batched over a leading axis
 B of cells of one grid size and side (``heights`` (B, M, M)); no loops over grid points.

@@ -24,7 +24,7 @@ import torch
 
 from metainterface._threads import in_background, stop_asked
 from metainterface.errors import MetainterfaceError
-from metainterface.physics.cell import Design
+from metainterface.physics.cell import CellSettings, Design
 from metainterface.physics.models import ForwardModel
 from metainterface.validation.adhesive_bem import solve_jkr
 
@@ -210,6 +210,32 @@ def _chains(
     if stopped:
         return states
     return {k: (second[k] if k == "pressure" else states[k] + second[k]) for k in second}
+
+
+#: Grid points per lattice cell side at most of an adhesive check or validation. The JKR-limit
+#: criterion pins each contact edge within a share of K_c that does not shrink with the grid
+#: (its thresholds are pixel-scale constants), so the BEM's error against JKR stops falling
+#: beyond it and, with strong adhesion, grows, and the check's two-grid estimate no longer
+#: holds: a Hertz asperity against the JKR closed form
+#: (``benchmarks/bench_adhesive_convergence.py``, benchmarks/results/adhesion.md).
+FINEST = 256
+
+
+def check_adhesive_grid(grid: int, settings: CellSettings) -> int:
+    """``check_grid`` for the adhesive BEM: also at most ``FINEST`` points per cell side.
+    Returns M; raises MetainterfaceError (argument ``grid``) with the allowed range."""
+    from metainterface.validation.heightmap import check_grid
+
+    m = check_grid(grid, settings)
+    n = settings.n_side
+    if m > FINEST * n:
+        raise MetainterfaceError(
+            f"grid must be at most {FINEST * n} ({FINEST} points per asperity) for an adhesive "
+            f"design, got {m}: the JKR-limit BEM is no more accurate on finer grids and its "
+            "error estimate does not hold there",
+            argument="grid",
+        )
+    return m
 
 
 #: Approaches of the path per load asked for: some states of the path are not on the

@@ -20,8 +20,12 @@ from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
 from metainterface.validation.adhesive_bem import MAX_ITER, TOLERANCE
-from metainterface.validation.adhesive_path import APPROACHES_PER_LOAD, rising_branch
-from metainterface.validation.heightmap import check_grid, default_grid, height_map
+from metainterface.validation.adhesive_path import (
+    APPROACHES_PER_LOAD,
+    check_adhesive_grid,
+    rising_branch,
+)
+from metainterface.validation.heightmap import default_grid, height_map
 from metainterface.validation.result import ValidationResult
 
 
@@ -37,7 +41,8 @@ def validate_adhesive(
 ) -> ValidationResult:
     """The JKR-limit BEM of ``design`` against the adhesive ``model`` (adhesion > 0).
 
-    grid: M points per side (default 256 n, as the adhesionless validation); loads: the
+    grid: M points per side (default 256 n, as the adhesionless validation; at most
+    ``adhesive_path.FINEST`` n, where the BEM's error stops falling); loads: the
     path takes ``APPROACHES_PER_LOAD * loads`` approaches up to a step past the model's
     load ``p_max`` (default P* at Delta_max); the states on the rising-force branch are the
     result's loads. Raises MetainterfaceError where none is.
@@ -47,7 +52,11 @@ def validate_adhesive(
     if not model.adhesion:
         raise MetainterfaceError("validate_adhesive needs a model with adhesion > 0")
     k = _checks.whole("loads", loads, low=1, high=10_000)
-    grid = default_grid(design.settings) if grid is None else check_grid(grid, design.settings)
+    grid = (
+        default_grid(design.settings)
+        if grid is None
+        else check_adhesive_grid(grid, design.settings)
+    )
     curve = model.model_curve(design)
     top = curve.p_star_max if p_max is None else min(float(p_max), curve.p_star_max)
     branch = rising_branch(

@@ -28,6 +28,11 @@ by 2^p - 1, p = 1 (``ORDER``). With errors of either sign that halve with the sp
 difference is about twice the fine grid's error, so the estimate bounds it: on a Hertz
 asperity against JKR, 14 % estimated against 6.2 % true at 64^2, 6.2 % against 2.9 % at
 128^2 (``tests/verify/test_adhesive_bound.py`` checks it there and against a finer grid).
+That holds up to ``adhesive_path.FINEST`` (256) points per asperity, the finest grid the
+check takes: past it the criterion's pinning of each edge (a share of K_c, not of the grid
+spacing) outweighs the pixel error, the error against JKR stops falling (with strong
+adhesion it grows) and two grids differ by less than either's error
+(``benchmarks/bench_adhesive_convergence.py``).
 
 A cell of several asperities jumps where each snaps in, and a state at a jump reads either
 side of it depending on where the approaches fall, on one grid and the next alike. So the
@@ -61,6 +66,7 @@ from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
 from metainterface.validation.adhesive_path import (  # noqa: F401  (re-exported)
     APPROACHES_PER_LOAD,
+    FINEST,
     TOUCH_MARGIN,
     approaches,
     at_snap_ins,
@@ -69,9 +75,10 @@ from metainterface.validation.adhesive_path import (  # noqa: F401  (re-exported
 )
 
 #: Grid points per lattice cell side of the default adhesive check's first fine grid (the
-#: adhesionless check's, 384^2 for N = 9), and the most it doubles to (768^2 for N = 9).
+#: adhesionless check's, 384^2 for N = 9), and the most it doubles to (768^2 for N = 9): the
+#: finest the adhesive BEM takes (``adhesive_path.FINEST``).
 GRID_START = 128
-GRID_MAX = 256
+GRID_MAX = FINEST
 #: The check's own error must be at most this share of ``Verify.max_error`` (issue 52).
 BOUND_SHARE = 0.25
 #: The convergence order assumed of the check's error with the grid spacing (see above).

@@ -149,13 +149,24 @@ class Verify:
                 argument="device",
             )
 
-    def ready(self, cell: CellSettings) -> None:
-        """Check what only the run can tell, before any work: the grid against the cell, the
-        engine installed (Tamaas) and the device seen by torch. One-line errors."""
+    def ready(self, cell: CellSettings, adhesive: bool = False) -> None:
+        """Check what only the run can tell, before any work: the grid against the cell (and,
+        for an ``adhesive`` design, against the adhesive BEM's finest), the engine installed
+        (Tamaas) and the device seen by torch. One-line errors."""
         from metainterface.validation.solvers import check_engine
 
         self.grid_for(cell)
+        if adhesive:
+            self.ready_adhesive(cell)
         check_engine(self.engine, self.device)
+
+    def ready_adhesive(self, cell: CellSettings) -> None:
+        """A grid given, checked for an adhesive design's check (at most
+        ``adhesive_path.FINEST`` points per asperity)."""
+        from metainterface.validation.adhesive_path import check_adhesive_grid
+
+        if self.grid is not None:
+            check_adhesive_grid(self.grid, cell)
 
     def grid_for(self, cell: CellSettings) -> int:
         """The check's grid for this cell (checked against it)."""
@@ -324,7 +335,7 @@ def _adhesive_check(
     rising force, at the states its path reaches (``verify.adhesive``)."""
     from metainterface.verify.adhesive import bounded_check
 
-    settings.grid_for(design.settings)  # a grid given is checked against the cell
+    settings.ready_adhesive(design.settings)  # a grid given is checked against the cell
     bounded = bounded_check(
         design,
         target,
