@@ -10,7 +10,14 @@ estimate holds it, and the mean signed error over the lowest third of the loads,
 contact's stress intensity sets alpha (a lagging loading edge reads low there).
 
     PYTHONPATH=src OMP_NUM_THREADS=1 python benchmarks/bench_adhesive_convergence.py
-        [--works 2e-5 4.2e-5 1e-4 2e-4 5e-4] [--grids 64 128 256 512]
+        [--works 2e-5 4.2e-5 1e-4 2e-4 5e-4] [--grids 64 128 256 512] [--classes 256 512]
+
+``--classes GRID ...`` prints instead why the criterion pins an edge: a bonded flat punch of
+radius L / 10 on each grid (a pull, no criterion), its edge points' tension and the points
+beside it's gap, grouped by how many of their 4- and diagonal neighbours are in contact, as
+factors of Kendall's K_I (tension |p| sqrt(dx) / K, gap g / (K sqrt(dx)), a from the pixel
+count); and the same for single points added beside the edge (a bump, bonded). The
+criterion uses one factor for every edge point (c_e) and one for every point beside it (c_g).
 
 The package refuses an adhesive check or validation finer than
 ``validation.adhesive_path.FINEST`` points per cell side; this benchmark goes past it to
@@ -49,12 +56,64 @@ def jkr_target(work: float) -> tuple[mi.Design, mi.Target]:
     return design, mi.Target(p_star=p, alpha=math.pi * a * a / side**2, name="jkr")
 
 
+def _counts(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(M, M) each point's count of 4-neighbours and of diagonal neighbours in ``mask``."""
+    four = sum(np.roll(mask, s, axis=a) for a in (0, 1) for s in (1, -1))
+    diag = sum(np.roll(np.roll(mask, s, 0), t, 1) for s in (1, -1) for t in (1, -1))
+    return four.astype(int), diag.astype(int)
+
+
+def edge_classes(grid: int, radius: float = 0.1) -> None:
+    """The bonded punch's edge factors by neighbour class (see the module's doc)."""
+    import torch
+
+    from metainterface.validation.adhesive_bem import _apply, _bonded, _spectral, forward_kernel
+
+    disc = np.hypot(*np.meshgrid(*(2 * [(np.arange(grid) - grid / 2) / grid]), indexing="ij"))
+    punch = disc < radius
+    four, diag = _counts(punch)
+    beside = np.flatnonzero((~punch & (four > 0)).ravel())
+    bumps = punch.copy()
+    bumps.flat[beside[:: max(1, beside.size // 40)]] = True  # ~40 bumps around the edge
+    dx = 1.0 / grid
+    fwd = forward_kernel(grid, 1.0, torch.device("cpu"))
+    pull = torch.full((1, 1, 1), -1e-3, dtype=torch.float64)
+    flat = torch.zeros((1, grid, grid), dtype=torch.float64)
+    print(f"grid {grid}, punch radius {radius * grid:.0f} points:")
+    for name, mask in (("punch", punch), ("with bumps", bumps)):
+        c = torch.as_tensor(mask)[None]
+        p, _ = _bonded(flat, pull, c, fwd, torch.zeros_like(flat), 1e-12, 20000)
+        gap = (_apply(p, _spectral(fwd, torch.complex128)) - pull)[0].numpy()
+        a = math.sqrt(punch.sum() * dx * dx / math.pi)  # the punch's radius, Kendall's K_I
+        k = float(p.sum().abs()) * dx * dx / (2.0 * math.sqrt(math.pi * a**3))
+        tension = p[0].abs().numpy() * math.sqrt(dx) / k
+        opening = gap / (k * math.sqrt(dx))
+        four, diag = _counts(mask)
+        sets = (("tension", mask & (four < 4), tension), ("gap", ~mask & (four > 0), opening))
+        if name != "punch":
+            new = bumps & ~punch
+            sets = (("bump tension", new, tension),)
+        for what, where, value in sets:
+            cells = sorted(set(zip(four[where].tolist(), diag[where].tolist(), strict=True)))
+            text = ", ".join(
+                f"({a},{b}) {value[where & (four == a) & (diag == b)].mean():.3f}"
+                f" +- {value[where & (four == a) & (diag == b)].std():.3f}"
+                for a, b in cells
+            )
+            print(f"  {name}: {what} by (4-, diagonal neighbours): {text}", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--works", type=float, nargs="+", default=[2e-5, 4.2e-5, 1e-4, 2e-4, 5e-4])
     ap.add_argument("--grids", type=int, nargs="+", default=[64, 128, 256, 512])
     ap.add_argument("--loads", type=int, default=10)
+    ap.add_argument("--classes", type=int, nargs="+", default=None, metavar="GRID")
     args = ap.parse_args()
+    if args.classes:
+        for grid in args.classes:
+            edge_classes(grid)
+        return
     print(f"the package's finest adhesive check: {FINEST} points per cell side")
     print(
         "| w [E* R] | grid | check's estimate | true error (vs JKR) | held "
