@@ -83,6 +83,10 @@ GRID_MAX = FINEST
 BOUND_SHARE = 0.25
 #: The convergence order assumed of the check's error with the grid spacing (see above).
 ORDER = 1.0
+#: The largest work of adhesion [E* R] at which the two-grid estimate was shown to hold the
+#: check's true error (a Hertz asperity against the JKR closed form, grids up to ``FINEST``:
+#: ``benchmarks/bench_adhesive_convergence.py``); above it the check says so.
+VALIDATED_WORK = 5e-4
 
 
 @dataclass(frozen=True)
@@ -267,5 +271,11 @@ def bounded_check(
             + ": its verdict holds to that"
         )
     )
-    fine = replace(fine, notes=(*fine.notes, note))
+    notes = (*fine.notes, note)
+    if model.adhesion > VALIDATED_WORK:
+        notes += (
+            f"w = {model.adhesion:.3g} E* R is above the {VALIDATED_WORK:g} E* R up to which "
+            "the check's own error estimate was shown to hold against JKR",
+        )
+    fine = replace(fine, notes=notes)
     return BoundedCheck(fine, fine_grid, acc, tuple(grids), time.perf_counter() - start)
