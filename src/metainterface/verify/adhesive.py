@@ -123,7 +123,12 @@ def solve_adhesive(
         design, model, grid=grid, samples=APPROACHES_PER_LOAD * loads, top=top, device=device
     )
     path, deltas, seconds, dev = branch.path, branch.approaches, branch.seconds, branch.device
-    keep = branch.keep & (path.p_star <= target.p_star_max * (1 + 1e-9))
+    # inside the target's range only: below its first row np.interp would hold the target
+    # at that row's alpha, an error the target does not state
+    inside = (path.p_star >= target.p_star[0] * (1 - 1e-9)) & (
+        path.p_star <= target.p_star_max * (1 + 1e-9)
+    )
+    keep = branch.keep & inside
     if not keep.any():
         raise MetainterfaceError(
             "the adhesive BEM reached no load inside the target's range on its rising branch "
