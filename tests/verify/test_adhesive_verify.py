@@ -47,19 +47,19 @@ def sticky_target():
 @pytest.fixture(scope="module")
 def corrected():
     """A design whose check reads an error well outside its own accuracy (a cell taller
-    than ``sticky_target``'s, loaded to its reach: 6.9 % +- 3 % at 96^2), so that the
-    correction runs; at 48^2 and 4 loads the check's accuracy is as large as its error, and
-    the correction rightly stops there."""
+    than ``sticky_target``'s, loaded to its reach: 7.2 % +- 0.6 % at 144^2, the model's
+    6.2 %), so that the correction runs; at 48^2 and 4 loads the check's accuracy is as
+    large as its error, and the correction rightly stops there."""
     model = mi.Independent(adhesion=W)
-    target = _held_back(3, 1.0, 16, 1.0)[1]
-    checks = mi.Verify(grid=96, loads=6, correct=True, iterations=1, restart=False, inner=None)
+    target = _held_back(5, 1.0, 16, 1.0)[1]
+    checks = mi.Verify(grid=144, loads=6, correct=True, iterations=1, restart=False, inner=None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return mi.design(target, model=model, verify=checks, effort=QUICK)
 
 
 def test_an_adhesive_design_is_checked_under_a_rising_force(corrected):
-    sticky_target = _held_back(3, 1.0, 16, 1.0)[1]
+    sticky_target = _held_back(5, 1.0, 16, 1.0)[1]
     check = corrected.bem
     assert check is not None and check.adhesion == pytest.approx(W)
     # the loads are the BEM path's states a rising force reaches, inside the target's range

@@ -255,17 +255,27 @@ RESTART_SHARE = 0.4
 
 
 def approaches(design: Design, model: ForwardModel, top: float, k: int) -> np.ndarray:
-    """(K,) rising approaches [length]: uniform from 0 to one step past the first approach
-    at which the model's loading curve reaches the load ``top`` (at most Delta_max)."""
+    """(K,) rising approaches [length], uniform from one step before the first approach at
+    which the model's loading force is positive to one step past the first at which it
+    reaches the load ``top`` (at most Delta_max). States before the force turns positive
+    are never on the rising-force branch, and an adhesive cell snaps in with a pull that it
+    carries over part of its approach: spaced from 0, with strong adhesion most states fell
+    there, and the lowest loads, where F_0 is, could go unchecked
+    (benchmarks/results/adhesion.md)."""
     s = design.settings
     gamma, h = design.tensors(torch.float64)
     with torch.no_grad():
         sweep = model.sweep(gamma, h, s)
     delta = (sweep.delta[0] if sweep.delta.dim() == 2 else sweep.delta).numpy()
-    reach = np.nonzero(sweep.p_star[0].numpy() >= top * (1 - 1e-9))[0]
+    p = sweep.p_star[0].numpy()
+    reach = np.nonzero(p >= top * (1 - 1e-9))[0]
     end = float(delta[reach[0]]) if reach.size else s.delta_max
-    end = min(s.delta_max, end * (1 + 1.0 / k))
-    return end * np.arange(1, k + 1) / k
+    positive = np.nonzero(p > 0)[0]
+    first = min(float(delta[positive[0]]) if positive.size else 0.0, end)
+    step = (end - first) / max(k - 1, 1)
+    start = max(0.0, first - step)
+    end = min(s.delta_max, end + step)
+    return start + (end - start) * np.arange(1, k + 1) / k
 
 
 def clear_of_snap_ins(p_star: np.ndarray, touching: np.ndarray, peaks: np.ndarray) -> np.ndarray:
