@@ -68,24 +68,24 @@ def edge_classes(grid: int, radius: float = 0.1) -> None:
     import torch
 
     from metainterface.validation.adhesive_bem import _apply, _bonded, _spectral, forward_kernel
+    from metainterface.validation.adhesive_edge import _kendall_k, _punch
 
-    disc = np.hypot(*np.meshgrid(*(2 * [(np.arange(grid) - grid / 2) / grid]), indexing="ij"))
-    punch = disc < radius
+    _, disc, dx = _punch(grid, radius)  # the calibration's own punch and Kendall's K_I
+    punch = disc[0].numpy()
     four, diag = _counts(punch)
     beside = np.flatnonzero((~punch & (four > 0)).ravel())
     bumps = punch.copy()
     bumps.flat[beside[:: max(1, beside.size // 40)]] = True  # ~40 bumps around the edge
-    dx = 1.0 / grid
     fwd = forward_kernel(grid, 1.0, torch.device("cpu"))
+    spectral = _spectral(fwd, torch.complex128)
     pull = torch.full((1, 1, 1), -1e-3, dtype=torch.float64)
     flat = torch.zeros((1, grid, grid), dtype=torch.float64)
     print(f"grid {grid}, punch radius {radius * grid:.0f} points:")
     for name, mask in (("punch", punch), ("with bumps", bumps)):
         c = torch.as_tensor(mask)[None]
         p, _ = _bonded(flat, pull, c, fwd, torch.zeros_like(flat), 1e-12, 20000)
-        gap = (_apply(p, _spectral(fwd, torch.complex128)) - pull)[0].numpy()
-        a = math.sqrt(punch.sum() * dx * dx / math.pi)  # the punch's radius, Kendall's K_I
-        k = float(p.sum().abs()) * dx * dx / (2.0 * math.sqrt(math.pi * a**3))
+        gap = (_apply(p, spectral) - pull)[0].numpy()
+        k = _kendall_k(p, float(punch.sum()), dx)
         tension = p[0].abs().numpy() * math.sqrt(dx) / k
         opening = gap / (k * math.sqrt(dx))
         four, diag = _counts(mask)

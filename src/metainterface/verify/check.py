@@ -155,9 +155,10 @@ class Verify:
         (Tamaas) and the device seen by torch. One-line errors."""
         from metainterface.validation.solvers import check_engine
 
-        self.grid_for(cell)
         if adhesive:
             self.ready_adhesive(cell)
+        else:
+            self.grid_for(cell)
         check_engine(self.engine, self.device)
 
     def ready_adhesive(self, cell: CellSettings) -> None:
