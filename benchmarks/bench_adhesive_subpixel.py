@@ -24,6 +24,13 @@ first-order part is taken out.
 
     PYTHONPATH=src OMP_NUM_THREADS=1 python benchmarks/bench_adhesive_subpixel.py
         [--works 1e-4 5e-4] [--grids 128 256 512]
+
+``--cell APPROACH --grids 384 [--discs 60 150] [--seeds 0 1 2]`` tries it on the package's
+nine-asperity example cell (w the first of ``--works``): one family whose nine radii vary
+at random together, each asperity's region force regressed on its own radius (a cubic) and
+on the others' (linear), so that the edges are found together. It prints P* and alpha per
+family size and seed (their spread is the regression's noise), beside the point-by-point
+BEM's state at the same approach, and the family's seconds.
 """
 
 from __future__ import annotations
@@ -47,6 +54,7 @@ from metainterface.validation.adhesive_bem import (
 from metainterface.validation.heightmap import height_map
 
 QUICK = "--works 1e-4 --grids 64 --approaches 2"
+# (the --cell mode is not in the quick run: it is a measurement of a route, minutes long)
 
 
 def jkr_radius(force: float, work: float) -> float:
@@ -124,13 +132,147 @@ def equilibrium(grid: int, work: float, approaches: np.ndarray, window: float) -
     return out
 
 
+def cell_state(
+    grid: int, work: float, c: float, discs: int, seed: int, window: float, order: str
+) -> dict:
+    """The nine-asperity example cell at approach ``c`` by a family of ``discs`` disc sets
+    whose nine radii vary at random (``seed``) within ``window`` spacings of the
+    point-by-point BEM's state, each region's force F_l regressed on its own radius (a
+    cubic) and the others' (linear), and each edge put where Maxwell's relation holds with
+    the total force. Returns P* and alpha of both, and the family's seconds."""
+    import json
+    from pathlib import Path
+
+    from metainterface.validation.adhesive_bem import solve_jkr
+
+    spec = json.loads((Path(mi.__file__).parent / "examples" / "example_design.json").read_text())
+    design = mi.Design(
+        gamma=np.array(spec["gamma"]), h=np.array(spec["h"]), settings=CellSettings()
+    )
+    hm = height_map(design, grid)
+    side, dx, own = hm.cell_side, hm.spacing, hm.owner
+    centres = design.settings.lattice_centres()[own]
+    x = np.arange(grid) * dx
+    dist = np.hypot(x[None, :] - centres[..., 0], x[:, None] - centres[..., 1])
+    z = torch.as_tensor(hm.heights)[None]
+    pixel = solve_jkr(z, side, torch.tensor([-float(z.mean()) - c]), work)
+    n = np.bincount(own[pixel.contact[0].numpy()], minlength=design.gamma.size)
+    touching = np.flatnonzero(n > 0)
+    rho = np.sqrt(n / math.pi) * dx
+    fwd = _spectral(forward_kernel(grid, side, z.device), torch.complex128)
+    stiff = _spectral(inverse_kernel(grid, side, z.device), PRECONDITIONER_DTYPE)
+    heights = torch.cat([z, torch.zeros_like(z)])
+    shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
+    rng = np.random.default_rng(seed)
+    t0 = time.perf_counter()
+    radius, force0, stiffness = [], [], []
+    p = torch.zeros_like(heights)
+    # "shells": each asperity's distinct radii in the window, in an order of its own, so
+    # every radius is drawn (as the single asperity's family) and the nine are unrelated
+    shells = [
+        np.unique(dist[(own == k) & (np.abs(dist - rho[k]) < window * dx)]) for k in range(n.size)
+    ]
+    orders = [rng.permutation(max(len(s), 1)) for s in shells]
+    for j in range(discs):
+        if order == "shells":
+            r = np.array(
+                [
+                    s[o[j % len(o)]] if len(s) and n[k] else -1.0
+                    for k, (s, o) in enumerate(zip(shells, orders, strict=True))
+                ]
+            )
+        else:
+            r = rho + rng.uniform(-window, window, n.size) * dx
+        r = np.where(n > 0, np.maximum(r, dx), -1)
+        sets = torch.as_tensor(dist <= r[own] + 1e-12)[None]
+        p, _res = _bonded(heights, shift, sets.expand(2, -1, -1), fwd, p * sets, 1e-12, 5000, stiff)
+        radius.append(
+            np.sqrt(np.bincount(own[sets[0].numpy()], minlength=n.size) / math.pi) * dx - rho
+        )
+        per = [
+            np.bincount(own.ravel(), weights=p[i].numpy().ravel(), minlength=n.size) for i in (0, 1)
+        ]
+        force0.append(per[0] * dx * dx)
+        stiffness.append(per[1] * dx * dx)
+    xs = np.array(radius)
+
+    def fit(y: np.ndarray) -> dict:  # region j: (own cubic, {k: linear in x_k})
+        out = {}
+        for j in touching:
+            rest = [k for k in touching if k != j]
+            a = np.column_stack([xs[:, j] ** q for q in range(4)] + [xs[:, k] for k in rest])
+            b = np.linalg.lstsq(a, np.array(y)[:, j], rcond=None)[0]
+            out[j] = (b[:4], dict(zip(rest, b[4:], strict=True)))
+        return out
+
+    f0, kk = fit(force0), fit(stiffness)
+
+    def slope(cf: dict, k: int, v: np.ndarray) -> np.ndarray:  # d(total)/dx_k
+        own_part = cf[k][0][1] + 2 * cf[k][0][2] * v + 3 * cf[k][0][3] * v * v
+        return own_part + sum(cf[j][1][k] for j in touching if j != k)
+
+    edge = np.zeros(n.size)
+    v = np.linspace(-(window - 1) * dx, (window - 1) * dx, 2001)
+    for k in touching:
+        balance = np.abs(slope(f0, k, v) + c * slope(kk, k, v)) - np.sqrt(
+            2 * math.pi * (rho[k] + v) * np.abs(slope(kk, k, v))
+        ) * math.sqrt(2 * work)
+        root = np.flatnonzero(np.diff(np.sign(balance)))
+        edge[k] = v[root[0]] if root.size else math.nan
+    total = 0.0
+    for cf, weight in ((f0, 1.0), (kk, c)):
+        for j in touching:
+            b, cross = cf[j]
+            total += weight * (
+                np.polyval(b[::-1], edge[j]) + sum(g * edge[k] for k, g in cross.items())
+            )
+    alpha = float(np.sum(math.pi * (rho + edge)[touching] ** 2)) / side**2
+    return {
+        "p_star": total / side**2,
+        "alpha": alpha,
+        "seconds": time.perf_counter() - t0,
+        "pixel": (float(pixel.p_star[0]), float(pixel.alpha[0])),
+        "touching": touching.size,
+    }
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--works", type=float, nargs="+", default=[1e-4, 5e-4])
     ap.add_argument("--grids", type=int, nargs="+", default=[128, 256, 512])
     ap.add_argument("--approaches", type=int, default=5)
     ap.add_argument("--window", type=float, default=3.0, help="spacings either side")
+    ap.add_argument(
+        "--cell",
+        type=float,
+        default=None,
+        metavar="APPROACH",
+        help="the nine-asperity example cell at this approach [R] instead",
+    )
+    ap.add_argument("--discs", type=int, nargs="+", default=[60, 150])
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    ap.add_argument(
+        "--order",
+        choices=("random", "shells"),
+        default="random",
+        help="the nine radii at random in the window, or each one's shells in turn",
+    )
     args = ap.parse_args()
+    if args.cell is not None:
+        print("| grid | discs | seed | P* | alpha | point-by-point P*, alpha | seconds |")
+        print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+        for grid in args.grids:
+            for discs in args.discs:
+                for seed in args.seeds:
+                    r = cell_state(
+                        grid, args.works[0], args.cell, discs, seed, args.window, args.order
+                    )
+                    print(
+                        f"| {grid} | {discs} | {seed} | {r['p_star']:.4e} | {r['alpha']:.5f} "
+                        f"| {r['pixel'][0]:.4e}, {r['pixel'][1]:.5f} | {r['seconds']:.1f} |",
+                        flush=True,
+                    )
+        return
     for work in args.works:
         # approaches from a step past where JKR's force turns positive to 0.018 R
         a0 = (4.5 * math.pi * work) ** (1 / 3)  # JKR's radius at F = 0
