@@ -32,6 +32,11 @@ on the others' (linear), so that the edges are found together. It prints P* and 
 family size and seed (their spread is the regression's noise), beside the point-by-point
 BEM's state at the same approach, and the family's seconds.
 
+``--reciprocal APPROACH ... --grids 192 384 768`` finds each of the example cell's edges from
+a family of its own asperity alone, the others' pressures held as loads, which reciprocity
+makes independent of the approach and of those loads (``reciprocal_state``): P* and alpha
+per grid, and alpha extrapolated from each grid and the one before (at a fixed approach).
+
 ``--ring THICKNESS ...`` measures the cheapest variant on the Hertz asperity: no fit, the
 exact differences between a disc and the disc grown by one ring (two solves a state), at
 disc radii 0.07-0.2 R; the mean error of alpha against JKR and its spread over the states.
@@ -169,6 +174,23 @@ def ring_states(grid: int, work: float, thickness: float) -> np.ndarray:
     return np.array(out)
 
 
+def _example_cell(grid: int):
+    """The package's nine-asperity example cell on ``grid``^2: (design, height map, each
+    point's offsets (x, y) from its asperity's centre and distance to it)."""
+    import json
+    from pathlib import Path
+
+    spec = json.loads((Path(mi.__file__).parent / "examples" / "example_design.json").read_text())
+    design = mi.Design(
+        gamma=np.array(spec["gamma"]), h=np.array(spec["h"]), settings=CellSettings()
+    )
+    hm = height_map(design, grid)
+    centres = design.settings.lattice_centres()[hm.owner]
+    x = np.arange(grid) * hm.spacing
+    dx_, dy_ = x[None, :] - centres[..., 0], x[:, None] - centres[..., 1]
+    return design, hm, dx_, dy_, np.hypot(dx_, dy_)
+
+
 def cell_state(
     grid: int, work: float, c: float, discs: int, seed: int, window: float, order: str
 ) -> dict:
@@ -177,20 +199,10 @@ def cell_state(
     point-by-point BEM's state, each region's force F_l regressed on its own radius (a
     cubic) and the others' (linear), and each edge put where Maxwell's relation holds with
     the total force. Returns P* and alpha of both, and the family's seconds."""
-    import json
-    from pathlib import Path
-
     from metainterface.validation.adhesive_bem import solve_jkr
 
-    spec = json.loads((Path(mi.__file__).parent / "examples" / "example_design.json").read_text())
-    design = mi.Design(
-        gamma=np.array(spec["gamma"]), h=np.array(spec["h"]), settings=CellSettings()
-    )
-    hm = height_map(design, grid)
+    design, hm, _, _, dist = _example_cell(grid)
     side, dx, own = hm.cell_side, hm.spacing, hm.owner
-    centres = design.settings.lattice_centres()[own]
-    x = np.arange(grid) * dx
-    dist = np.hypot(x[None, :] - centres[..., 0], x[:, None] - centres[..., 1])
     z = torch.as_tensor(hm.heights)[None]
     pixel = solve_jkr(z, side, torch.tensor([-float(z.mean()) - c]), work)
     n = np.bincount(own[pixel.contact[0].numpy()], minlength=design.gamma.size)
@@ -209,7 +221,8 @@ def cell_state(
     shells = [
         np.unique(dist[(own == k) & (np.abs(dist - rho[k]) < window * dx)]) for k in range(n.size)
     ]
-    orders = [rng.permutation(max(len(s), 1)) for s in shells]
+    # (drawn only for that order: the random order's draws are the first the seed gives)
+    orders = [rng.permutation(max(len(s), 1)) for s in shells] if order == "shells" else []
     for j in range(discs):
         if order == "shells":
             r = np.array(
@@ -273,6 +286,99 @@ def cell_state(
     }
 
 
+def reciprocal_state(grid: int, work: float, c: float, window: float) -> dict:
+    """The example cell at approach ``c``, each edge from a family of its own asperity alone.
+
+    Disc k bonded under the other asperities' displacement u_ext carries, by reciprocity,
+    F_k(a) = F_0k(a) + c k_k(a) - sum(p1_k(a) u_ext) (p1_k(a) the disc's pressure under a
+    unit approach); with u_ext fitted by u_0 + u_2 r^2 (+ a tilt, which a centred disc does
+    not feel) over the disc, F_k(a) = F_0k(a) + (c - u_0) k_k(a) - u_2 M2_k(a),
+    M2_k = sum(p1_k r^2). F_0k, k_k and M2_k are solved for every distinct radius within
+    ``window`` spacings of the edge, disc k alone in the periodic cell (independent of c and
+    of u_ext: a path would solve them once), fitted by cubics, and the edge put where
+    Maxwell's relation holds for F_k. The discs' radii and u_ext are iterated with coupled
+    solves of all nine discs until the edges move by less than 0.05 spacing."""
+    from metainterface.validation.adhesive_bem import _apply, solve_jkr
+
+    design, hm, off_x, off_y, dist = _example_cell(grid)
+    side, dx, own = hm.cell_side, hm.spacing, hm.owner
+    z = torch.as_tensor(hm.heights)[None]
+    fwd = _spectral(forward_kernel(grid, side, z.device), torch.complex128)
+    stiff = _spectral(inverse_kernel(grid, side, z.device), PRECONDITIONER_DTYPE)
+    heights = torch.cat([z, torch.zeros_like(z)])
+    shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
+    t0 = time.perf_counter()
+    pixel = solve_jkr(z, side, torch.tensor([-float(z.mean()) - c]), work)
+    n = np.bincount(own[pixel.contact[0].numpy()], minlength=design.gamma.size)
+    touching = np.flatnonzero(n > 0)
+    rho = np.sqrt(n / math.pi) * dx
+    cache: dict[tuple[int, float], tuple[float, float, float, float]] = {}
+
+    def alone(k: int, r: float) -> tuple[float, float, float, float]:  # (a, F_0k, k_k, M2_k)
+        key = (k, round(r / dx, 9))
+        if key not in cache:
+            disc = torch.as_tensor((own == k) & (dist <= r + 1e-12))[None].expand(2, -1, -1)
+            p, _ = _bonded(heights, shift, disc, fwd, torch.zeros_like(heights), 1e-12, 5000, stiff)
+            unit = p[1].numpy()
+            cache[key] = (
+                math.sqrt(float(disc[0].sum()) / math.pi) * dx,
+                float(p[0].sum()) * dx * dx,
+                float(unit.sum()) * dx * dx,
+                float((unit * dist**2).sum()) * dx * dx,
+            )
+        return cache[key]
+
+    k_c = math.sqrt(2.0 * work)
+    s = np.linspace(-(window - 1) * dx, (window - 1) * dx, 4001)
+    for _ in range(6):
+        sets = torch.as_tensor(np.isin(own, touching) & (dist <= rho[own] + 1e-12))[None]
+        p, _ = _bonded(
+            heights,
+            shift,
+            sets.expand(2, -1, -1),
+            fwd,
+            torch.zeros_like(heights),
+            1e-12,
+            5000,
+            stiff,
+        )
+        pressure = p[0] + c * p[1]
+        others = torch.stack([pressure * torch.as_tensor(own != k) for k in touching])
+        u_ext = _apply(others, fwd).numpy()
+        edge, force = rho.copy(), 0.0
+        for i, k in enumerate(touching):
+            near = (own == k) & (dist <= rho[k] + window * dx)
+            basis = np.column_stack(
+                [np.ones(near.sum()), dist[near] ** 2, off_x[near], off_y[near]]
+            )
+            u0, u2 = np.linalg.lstsq(basis, u_ext[i][near], rcond=None)[0][:2]
+            radii = np.unique(
+                np.round(dist[(own == k) & (np.abs(dist - rho[k]) < window * dx)], 12)
+            )
+            a, f0, kk, m2 = np.array([alone(k, r) for r in radii]).T
+            cf = np.polyfit(a - rho[k], f0 + (c - u0) * kk - u2 * m2, 3)
+            ck = np.polyfit(a - rho[k], kk, 3)
+            balance = (
+                np.abs(np.polyval(np.polyder(cf), s))
+                - np.sqrt(2 * math.pi * (rho[k] + s) * np.abs(np.polyval(np.polyder(ck), s))) * k_c
+            )
+            root = np.flatnonzero(np.diff(np.sign(balance)))
+            at = s[root[0]] if root.size else s[np.argmin(np.abs(balance))]
+            edge[k] = rho[k] + at
+            force += np.polyval(cf, at)
+        moved = float(np.abs(edge - rho)[touching].max()) / dx
+        rho = edge
+        if moved < 0.05:
+            break
+    return {
+        "p_star": force / side**2,
+        "alpha": float(np.sum(math.pi * rho[touching] ** 2)) / side**2,
+        "discs": len(cache),
+        "seconds": time.perf_counter() - t0,
+        "pixel": (float(pixel.p_star[0]), float(pixel.alpha[0])),
+    }
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--works", type=float, nargs="+", default=[1e-4, 5e-4])
@@ -302,7 +408,34 @@ def main() -> None:
         metavar="THICKNESS",
         help="the one-ring variant, rings this many spacings thick, instead",
     )
+    ap.add_argument(
+        "--reciprocal",
+        type=float,
+        nargs="+",
+        default=None,
+        metavar="APPROACH",
+        help="the example cell, each edge from its own asperity's family, instead",
+    )
     args = ap.parse_args()
+    if args.reciprocal:
+        print(
+            "| approach [R] | grid | P* | alpha | 2 alpha - alpha(M / 2) | discs | seconds "
+            "| point-by-point P*, alpha |"
+        )
+        print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+        for c in args.reciprocal:
+            before = None
+            for grid in args.grids:
+                r = reciprocal_state(grid, args.works[0], c, args.window)
+                rich = "" if before is None else f"{2 * r['alpha'] - before:.5f}"
+                before = r["alpha"]
+                print(
+                    f"| {c:g} | {grid} | {r['p_star']:.5e} | {r['alpha']:.5f} | {rich} "
+                    f"| {r['discs']} | {r['seconds']:.1f} "
+                    f"| {r['pixel'][0]:.5e}, {r['pixel'][1]:.5f} |",
+                    flush=True,
+                )
+        return
     if args.ring:
         print("| w [E* R] | grid | ring [dx] | states | mean error of alpha | its spread (std) |")
         print("| ---: | ---: | ---: | ---: | ---: | ---: |")
