@@ -286,74 +286,73 @@ def cell_state(
     }
 
 
-def reciprocal_state(grid: int, work: float, c: float, window: float) -> dict:
-    """The example cell at approach ``c``, each edge from a family of its own asperity alone.
+class ReciprocalCell:
+    """The example cell on ``grid``^2 with each edge from its own asperity's family.
 
     Disc k bonded under the other asperities' displacement u_ext carries, by reciprocity,
     F_k(a) = F_0k(a) + c k_k(a) - sum(p1_k(a) u_ext) (p1_k(a) the disc's pressure under a
     unit approach); with u_ext fitted by u_0 + u_2 r^2 (+ a tilt, which a centred disc does
     not feel) over the disc, F_k(a) = F_0k(a) + (c - u_0) k_k(a) - u_2 M2_k(a),
-    M2_k = sum(p1_k r^2). F_0k, k_k and M2_k are solved for every distinct radius within
-    ``window`` spacings of the edge, disc k alone in the periodic cell (independent of c and
-    of u_ext: a path would solve them once), fitted by cubics, and the edge put where
-    Maxwell's relation holds for F_k. The discs' radii and u_ext are iterated with coupled
-    solves of all nine discs until the edges move by less than 0.05 spacing."""
-    from metainterface.validation.adhesive_bem import _apply, solve_jkr
+    M2_k = sum(p1_k r^2). F_0k, k_k and M2_k, disc k alone in the periodic cell, depend on
+    neither c nor u_ext: each disc is solved once (``alone``) for every state that needs it.
+    ``settle`` puts each edge where Maxwell's relation holds for its F_k (cubic fits over
+    the distinct radii within ``window`` spacings), iterating the radii and u_ext with
+    coupled solves of the touching discs until the edges move by less than 0.05 spacing.
 
-    design, hm, off_x, off_y, dist = _example_cell(grid)
-    side, dx, own = hm.cell_side, hm.spacing, hm.owner
-    z = torch.as_tensor(hm.heights)[None]
-    fwd = _spectral(forward_kernel(grid, side, z.device), torch.complex128)
-    stiff = _spectral(inverse_kernel(grid, side, z.device), PRECONDITIONER_DTYPE)
-    heights = torch.cat([z, torch.zeros_like(z)])
-    shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
-    t0 = time.perf_counter()
-    pixel = solve_jkr(z, side, torch.tensor([-float(z.mean()) - c]), work)
-    n = np.bincount(own[pixel.contact[0].numpy()], minlength=design.gamma.size)
-    touching = np.flatnonzero(n > 0)
-    rho = np.sqrt(n / math.pi) * dx
-    cache: dict[tuple[int, float], tuple[float, float, float, float]] = {}
+    A disc alone lies within ``reach`` points of its centre, so its solves run on a window
+    of 2m x 2m points, m = 2 reach + 2 (at most the lattice square + 2), the cell's periodic
+    kernel cut to offsets below m and zero-padded: a linear convolution, exact for every pair
+    of the window's points (``window_error`` checks it against the whole cell).
+    """
 
-    # Disc k alone lies within its largest radius here (the edge, 3 spacings of window and
-    # 3 of margin) of its centre: its solves run on a window of 2m x 2m points, m the
-    # diameter that reaches plus 2, the cell's periodic kernel cut to offsets below m and
-    # zero-padded (a linear convolution: exact for every pair of the window's points, which
-    # the last column of the table checks, on a quarter to a ninth of the cell's points)
-    reach = math.ceil(float(rho[touching].max()) / dx + window + 3)
-    m = min(grid // design.settings.n_side, 2 * reach) + 2
-    kernel = torch.fft.irfft2(
-        forward_kernel(grid, side, z.device)[0].to(torch.complex128), s=(grid, grid)
-    )
-    cut = torch.zeros(2 * m, 2 * m, dtype=torch.float64)
-    near_, src = np.r_[0:m, m + 1 : 2 * m], np.r_[0:m, grid - m + 1 : grid]
-    cut[np.ix_(near_, near_)] = kernel[np.ix_(src, src)]
-    fwd_w = _spectral(torch.fft.rfft2(cut)[None], torch.complex128)
-    stiff_w = _spectral(inverse_kernel(2 * m, 2 * m * dx, z.device), PRECONDITIONER_DTYPE)
-
-    def windowed(k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # (z, dist, in k's square)
-        cy, cx = np.unravel_index(np.argmin(np.where(own == k, dist, np.inf)), dist.shape)
-        rows, cols = np.ix_(
-            (np.arange(m) + cy - m // 2) % grid, (np.arange(m) + cx - m // 2) % grid
+    def __init__(self, grid: int, work: float, window: float, reach: int) -> None:
+        self.design, self.hm, self.off_x, self.off_y, self.dist = _example_cell(grid)
+        self.grid, self.work, self.window = grid, work, window
+        self.side, self.dx, self.own = self.hm.cell_side, self.hm.spacing, self.hm.owner
+        z = torch.as_tensor(self.hm.heights)[None]
+        self.fwd = _spectral(forward_kernel(grid, self.side, z.device), torch.complex128)
+        self.stiff = _spectral(inverse_kernel(grid, self.side, z.device), PRECONDITIONER_DTYPE)
+        self.heights = torch.cat([z, torch.zeros_like(z)])
+        self.shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
+        m = min(grid // self.design.settings.n_side, 2 * reach) + 2
+        kernel = torch.fft.irfft2(
+            forward_kernel(grid, self.side, z.device)[0].to(torch.complex128), s=(grid, grid)
         )
-        zw, dw, mine = (
-            np.zeros((2 * m, 2 * m)),
-            np.full((2 * m, 2 * m), np.inf),
-            np.zeros((2 * m, 2 * m), dtype=bool),
+        cut = torch.zeros(2 * m, 2 * m, dtype=torch.float64)
+        near, src = np.r_[0:m, m + 1 : 2 * m], np.r_[0:m, grid - m + 1 : grid]
+        cut[np.ix_(near, near)] = kernel[np.ix_(src, src)]
+        self.m = m
+        self.fwd_w = _spectral(torch.fft.rfft2(cut)[None], torch.complex128)
+        self.stiff_w = _spectral(
+            inverse_kernel(2 * m, 2 * m * self.dx, z.device), PRECONDITIONER_DTYPE
         )
-        zw[:m, :m], dw[:m, :m], mine[:m, :m] = (
-            hm.heights[rows, cols],
-            dist[rows, cols],
-            (own[rows, cols] == k),
-        )
-        return zw, dw, mine
+        self.windows: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self.cache: dict[tuple[int, float], tuple[float, float, float, float]] = {}
 
-    windows = {int(k): windowed(int(k)) for k in touching}
+    def _window(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Disc k's window: heights, distances to its centre (inf off it), its own points."""
+        if k not in self.windows:
+            m, dist, own = self.m, self.dist, self.own
+            cy, cx = np.unravel_index(np.argmin(np.where(own == k, dist, np.inf)), dist.shape)
+            rows, cols = np.ix_(
+                (np.arange(m) + cy - m // 2) % self.grid, (np.arange(m) + cx - m // 2) % self.grid
+            )
+            zw, dw = np.zeros((2 * m, 2 * m)), np.full((2 * m, 2 * m), np.inf)
+            mine = np.zeros((2 * m, 2 * m), dtype=bool)
+            zw[:m, :m], dw[:m, :m] = self.hm.heights[rows, cols], dist[rows, cols]
+            mine[:m, :m] = own[rows, cols] == k
+            self.windows[k] = (zw, dw, mine)
+        return self.windows[k]
 
-    def sums(k: int, r: float) -> tuple[float, float, float, float]:  # (a, F_0k, k_k, M2_k)
-        zw, dw, mine = windows[k]
+    def sums(self, k: int, r: float) -> tuple[float, float, float, float]:
+        """Disc k of radius r alone, on its window: (a, F_0k, k_k, M2_k)."""
+        zw, dw, mine = self._window(k)
+        m, dx = self.m, self.dx
         disc = torch.as_tensor(mine & (dw <= r + 1e-12))[None].expand(2, -1, -1)
         hw = torch.stack([torch.as_tensor(zw), torch.zeros(2 * m, 2 * m, dtype=torch.float64)])
-        p, _ = _bonded(hw, shift, disc, fwd_w, torch.zeros_like(hw), 1e-12, 5000, stiff_w)
+        p, _ = _bonded(
+            hw, self.shift, disc, self.fwd_w, torch.zeros_like(hw), 1e-12, 5000, self.stiff_w
+        )
         unit = p[1].numpy()
         return (
             math.sqrt(float(disc[0].sum()) / math.pi) * dx,
@@ -362,74 +361,121 @@ def reciprocal_state(grid: int, work: float, c: float, window: float) -> dict:
             float((unit * np.where(mine, dw, 0.0) ** 2).sum()) * dx * dx,
         )
 
-    def alone(k: int, r: float) -> tuple[float, float, float, float]:  # sums(), once a disc
-        key = (k, round(r / dx, 9))
-        if key not in cache:
-            cache[key] = sums(k, r)
-        return cache[key]
+    def alone(self, k: int, r: float) -> tuple[float, float, float, float]:
+        key = (k, round(r / self.dx, 9))
+        if key not in self.cache:
+            self.cache[key] = self.sums(k, r)
+        return self.cache[key]
 
-    def whole_cell(k: int, r: float) -> np.ndarray:  # alone()'s three sums, on the cell
+    def window_error(self, k: int, r: float) -> float:
+        """Largest relative difference of ``sums``' three sums against the whole cell."""
+        own, dist, dx = self.own, self.dist, self.dx
         disc = torch.as_tensor((own == k) & (dist <= r + 1e-12))[None].expand(2, -1, -1)
-        p, _ = _bonded(heights, shift, disc, fwd, torch.zeros_like(heights), 1e-12, 5000, stiff)
-        unit = p[1].numpy()
-        sums = [float(p[0].sum()), float(unit.sum()), float((unit * dist**2).sum())]
-        return np.array(sums) * dx * dx
-
-    k_c = math.sqrt(2.0 * work)
-    s = np.linspace(-(window - 1) * dx, (window - 1) * dx, 4001)
-    for _ in range(6):
-        sets = torch.as_tensor(np.isin(own, touching) & (dist <= rho[own] + 1e-12))[None]
         p, _ = _bonded(
-            heights,
-            shift,
-            sets.expand(2, -1, -1),
-            fwd,
-            torch.zeros_like(heights),
+            self.heights,
+            self.shift,
+            disc,
+            self.fwd,
+            torch.zeros_like(self.heights),
             1e-12,
             5000,
-            stiff,
+            self.stiff,
         )
-        pressure = p[0] + c * p[1]
-        others = torch.stack([pressure * torch.as_tensor(own != k) for k in touching])
-        u_ext = _apply(others, fwd).numpy()
-        edge, force = rho.copy(), 0.0
-        for i, k in enumerate(touching):
-            near = (own == k) & (dist <= rho[k] + window * dx)
-            basis = np.column_stack(
-                [np.ones(near.sum()), dist[near] ** 2, off_x[near], off_y[near]]
-            )
-            u0, u2 = np.linalg.lstsq(basis, u_ext[i][near], rcond=None)[0][:2]
-            radii = np.unique(
-                np.round(dist[(own == k) & (np.abs(dist - rho[k]) < window * dx)], 12)
-            )
-            a, f0, kk, m2 = np.array([alone(k, r) for r in radii]).T
-            cf = np.polyfit(a - rho[k], f0 + (c - u0) * kk - u2 * m2, 3)
-            ck = np.polyfit(a - rho[k], kk, 3)
-            balance = (
-                np.abs(np.polyval(np.polyder(cf), s))
-                - np.sqrt(2 * math.pi * (rho[k] + s) * np.abs(np.polyval(np.polyder(ck), s))) * k_c
-            )
-            root = np.flatnonzero(np.diff(np.sign(balance)))
-            at = s[root[0]] if root.size else s[np.argmin(np.abs(balance))]
-            edge[k] = rho[k] + at
-            force += np.polyval(cf, at)
-        moved = float(np.abs(edge - rho)[touching].max()) / dx
-        rho = edge
-        if moved < 0.05:
-            break
+        unit = p[1].numpy()
+        whole = np.array([float(p[0].sum()), float(unit.sum()), float((unit * dist**2).sum())])
+        return float(np.max(np.abs(np.array(self.sums(k, r)[1:]) / (whole * dx * dx) - 1)))
+
+    def coupled(self, c: float, rho: np.ndarray, touching: np.ndarray) -> torch.Tensor:
+        """(M, M) the pressure of the touching discs (radii ``rho``) bonded at approach c."""
+        own, dist = self.own, self.dist
+        sets = torch.as_tensor(np.isin(own, touching) & (dist <= rho[own] + 1e-12))[None]
+        p, _ = _bonded(
+            self.heights,
+            self.shift,
+            sets.expand(2, -1, -1),
+            self.fwd,
+            torch.zeros_like(self.heights),
+            1e-12,
+            5000,
+            self.stiff,
+        )
+        return p[0] + c * p[1]
+
+    def settle(self, c: float, rho: np.ndarray, touching: np.ndarray) -> tuple[np.ndarray, float]:
+        """The edges (N,) at approach c from the radii ``rho``, and the force there."""
+        from metainterface.validation.adhesive_bem import _apply
+
+        own, dist, dx, window = self.own, self.dist, self.dx, self.window
+        k_c = math.sqrt(2.0 * self.work)
+        s = np.linspace(-(window - 1) * dx, (window - 1) * dx, 4001)
+        rho = rho.copy()
+        force = 0.0
+        for _ in range(8):
+            pressure = self.coupled(c, rho, touching)
+            others = torch.stack([pressure * torch.as_tensor(own != k) for k in touching])
+            u_ext = _apply(others, self.fwd).numpy()
+            edge, force = rho.copy(), 0.0
+            for i, k in enumerate(touching):
+                near = (own == k) & (dist <= rho[k] + window * dx)
+                basis = np.column_stack(
+                    [np.ones(near.sum()), dist[near] ** 2, self.off_x[near], self.off_y[near]]
+                )
+                u0, u2 = np.linalg.lstsq(basis, u_ext[i][near], rcond=None)[0][:2]
+                centre = rho[k]
+                for _ in range(10):  # recentre the window until the root is inside it
+                    mine = (own == k) & (np.abs(dist - centre) < window * dx)
+                    radii = np.unique(np.round(dist[mine], 12))
+                    a, f0, kk, m2 = np.array([self.alone(int(k), r) for r in radii]).T
+                    cf = np.polyfit(a - centre, f0 + (c - u0) * kk - u2 * m2, 3)
+                    ck = np.polyfit(a - centre, kk, 3)
+                    balance = (
+                        np.abs(np.polyval(np.polyder(cf), s))
+                        - np.sqrt(
+                            2
+                            * math.pi
+                            * np.maximum(centre + s, 0.0)
+                            * np.abs(np.polyval(np.polyder(ck), s))
+                        )
+                        * k_c
+                    )
+                    root = np.flatnonzero(np.diff(np.sign(balance)))
+                    if root.size:
+                        break
+                    centre = max(centre + s[np.argmin(np.abs(balance))], window * dx)
+                at = s[root[0]] if root.size else s[np.argmin(np.abs(balance))]
+                edge[k] = centre + at
+                force += np.polyval(cf, at)
+            moved = float(np.abs(edge - rho)[touching].max()) / dx
+            rho = edge
+            if moved < 0.05:
+                break
+        return rho, force
+
+
+def reciprocal_state(grid: int, work: float, c: float, window: float) -> dict:
+    """The example cell at approach ``c`` (``ReciprocalCell``), from the point-by-point
+    BEM's state there: P*, alpha, discs solved, seconds, that state, and the window's check."""
+    from metainterface.validation.adhesive_bem import solve_jkr
+
+    design, hm, _, _, _ = _example_cell(grid)
+    z = torch.as_tensor(hm.heights)[None]
+    t0 = time.perf_counter()
+    pixel = solve_jkr(z, hm.cell_side, torch.tensor([-float(z.mean()) - c]), work)
+    n = np.bincount(hm.owner[pixel.contact[0].numpy()], minlength=design.gamma.size)
+    touching = np.flatnonzero(n > 0)
+    rho = np.sqrt(n / math.pi) * hm.spacing
+    reach = math.ceil(float(rho[touching].max()) / hm.spacing + window + 3)
+    cell = ReciprocalCell(grid, work, window, reach)
+    rho, force = cell.settle(c, rho, touching)
     seconds = time.perf_counter() - t0
-    # the window against the whole cell, once a state: the first touching disc at its edge
     k0 = int(touching[0])
-    window_error = float(
-        np.max(np.abs(np.array(sums(k0, rho[k0])[1:]) / whole_cell(k0, rho[k0]) - 1))
-    )
     return {
-        "p_star": force / side**2,
-        "alpha": float(np.sum(math.pi * rho[touching] ** 2)) / side**2,
-        "discs": len(cache),
+        "p_star": force / hm.cell_side**2,
+        "alpha": float(np.sum(math.pi * rho[touching] ** 2)) / hm.cell_side**2,
+        "discs": len(cell.cache),
         "seconds": seconds,
         "pixel": (float(pixel.p_star[0]), float(pixel.alpha[0])),
-        "window_error": window_error,
+        "window_error": cell.window_error(k0, rho[k0]),
     }
 
 
