@@ -299,13 +299,14 @@ class ReciprocalCell:
     the distinct radii within ``window`` spacings), iterating the radii and u_ext with
     coupled solves of the touching discs until the edges move by less than 0.05 spacing.
 
-    A disc alone lies within ``reach`` points of its centre, so its solves run on a window
-    of 2m x 2m points, m = 2 reach + 2 (at most the lattice square + 2), the cell's periodic
+    A disc alone lies within ``reach`` points of its centre (one for all, or (N,) one an
+    asperity), so its solves run on a window of 2m x 2m points, m = 2 reach + 2 (at most the
+    lattice square + 2), the cell's periodic
     kernel cut to offsets below m and zero-padded: a linear convolution, exact for every pair
     of the window's points (``window_error`` checks it against the whole cell).
     """
 
-    def __init__(self, grid: int, work: float, window: float, reach: int) -> None:
+    def __init__(self, grid: int, work: float, window: float, reach: int | np.ndarray) -> None:
         self.design, self.hm, self.off_x, self.off_y, self.dist = _example_cell(grid)
         self.grid, self.work, self.window = grid, work, window
         self.side, self.dx, self.own = self.hm.cell_side, self.hm.spacing, self.hm.owner
@@ -314,25 +315,34 @@ class ReciprocalCell:
         self.stiff = _spectral(inverse_kernel(grid, self.side, z.device), PRECONDITIONER_DTYPE)
         self.heights = torch.cat([z, torch.zeros_like(z)])
         self.shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
-        m = min(grid // self.design.settings.n_side, 2 * reach) + 2
-        kernel = torch.fft.irfft2(
+        side_points = grid // self.design.settings.n_side
+        reaches = np.broadcast_to(np.asarray(reach), self.design.gamma.shape)
+        self.m = [min(side_points, 2 * int(r)) + 2 for r in reaches]  # each disc's window
+        self.kernel = torch.fft.irfft2(
             forward_kernel(grid, self.side, z.device)[0].to(torch.complex128), s=(grid, grid)
         )
-        cut = torch.zeros(2 * m, 2 * m, dtype=torch.float64)
-        near, src = np.r_[0:m, m + 1 : 2 * m], np.r_[0:m, grid - m + 1 : grid]
-        cut[np.ix_(near, near)] = kernel[np.ix_(src, src)]
-        self.m = m
-        self.fwd_w = _spectral(torch.fft.rfft2(cut)[None], torch.complex128)
-        self.stiff_w = _spectral(
-            inverse_kernel(2 * m, 2 * m * self.dx, z.device), PRECONDITIONER_DTYPE
-        )
+        self.kernels: dict[int, tuple[torch.Tensor, torch.Tensor]] = {}
         self.windows: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self.cache: dict[tuple[int, float], tuple[float, float, float, float]] = {}
+
+    def _kernels(self, m: int) -> tuple[torch.Tensor, torch.Tensor]:
+        """The window of 2m x 2m points' compliance (the cell's kernel cut to offsets below
+        m, zero-padded) and preconditioner, both as ``_bonded`` takes them."""
+        if m not in self.kernels:
+            grid = self.grid
+            cut = torch.zeros(2 * m, 2 * m, dtype=torch.float64)
+            near, src = np.r_[0:m, m + 1 : 2 * m], np.r_[0:m, grid - m + 1 : grid]
+            cut[np.ix_(near, near)] = self.kernel[np.ix_(src, src)]
+            self.kernels[m] = (
+                _spectral(torch.fft.rfft2(cut)[None], torch.complex128),
+                _spectral(inverse_kernel(2 * m, 2 * m * self.dx, cut.device), PRECONDITIONER_DTYPE),
+            )
+        return self.kernels[m]
 
     def _window(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Disc k's window: heights, distances to its centre (inf off it), its own points."""
         if k not in self.windows:
-            m, dist, own = self.m, self.dist, self.own
+            m, dist, own = self.m[k], self.dist, self.own
             cy, cx = np.unravel_index(np.argmin(np.where(own == k, dist, np.inf)), dist.shape)
             rows, cols = np.ix_(
                 (np.arange(m) + cy - m // 2) % self.grid, (np.arange(m) + cx - m // 2) % self.grid
@@ -347,12 +357,11 @@ class ReciprocalCell:
     def sums(self, k: int, r: float) -> tuple[float, float, float, float]:
         """Disc k of radius r alone, on its window: (a, F_0k, k_k, M2_k)."""
         zw, dw, mine = self._window(k)
-        m, dx = self.m, self.dx
+        m, dx = self.m[k], self.dx
+        fwd_w, stiff_w = self._kernels(m)
         disc = torch.as_tensor(mine & (dw <= r + 1e-12))[None].expand(2, -1, -1)
         hw = torch.stack([torch.as_tensor(zw), torch.zeros(2 * m, 2 * m, dtype=torch.float64)])
-        p, _ = _bonded(
-            hw, self.shift, disc, self.fwd_w, torch.zeros_like(hw), 1e-12, 5000, self.stiff_w
-        )
+        p, _ = _bonded(hw, self.shift, disc, fwd_w, torch.zeros_like(hw), 1e-12, 5000, stiff_w)
         unit = p[1].numpy()
         return (
             math.sqrt(float(disc[0].sum()) / math.pi) * dx,
@@ -421,15 +430,17 @@ class ReciprocalCell:
                     [np.ones(near.sum()), dist[near] ** 2, self.off_x[near], self.off_y[near]]
                 )
                 u0, u2 = np.linalg.lstsq(basis, u_ext[i][near], rcond=None)[0][:2]
-                centre = rho[k]
-                for _ in range(10):  # recentre the window until the root is inside it
+                centre = max(rho[k], window * dx)
+                for _ in range(24):  # move the window until the edge is inside it
                     mine = (own == k) & (np.abs(dist - centre) < window * dx)
                     radii = np.unique(np.round(dist[mine], 12))
                     a, f0, kk, m2 = np.array([self.alone(int(k), r) for r in radii]).T
                     cf = np.polyfit(a - centre, f0 + (c - u0) * kk - u2 * m2, 3)
                     ck = np.polyfit(a - centre, kk, 3)
+                    # K_k - K_c in force units: K_k from -dF/da (a tensile edge: the force
+                    # falls as the disc grows); rises through 0 at the stable edge
                     balance = (
-                        np.abs(np.polyval(np.polyder(cf), s))
+                        -np.polyval(np.polyder(cf), s)
                         - np.sqrt(
                             2
                             * math.pi
@@ -438,11 +449,15 @@ class ReciprocalCell:
                         )
                         * k_c
                     )
-                    root = np.flatnonzero(np.diff(np.sign(balance)))
-                    if root.size:
+                    up = np.flatnonzero((balance[:-1] < 0) & (balance[1:] >= 0))
+                    if up.size:
+                        root = up[np.argmin(np.abs(s[up]))]
                         break
-                    centre = max(centre + s[np.argmin(np.abs(balance))], window * dx)
-                at = s[root[0]] if root.size else s[np.argmin(np.abs(balance))]
+                    step = (window - 1) * dx
+                    centre = centre + step if balance[-1] < 0 else max(centre - step, window * dx)
+                else:
+                    raise RuntimeError(f"no edge found for asperity {k} at approach {c:g}")
+                at = s[root]
                 edge[k] = centre + at
                 force += np.polyval(cf, at)
             moved = float(np.abs(edge - rho)[touching].max()) / dx
@@ -476,6 +491,60 @@ def reciprocal_state(grid: int, work: float, c: float, window: float) -> dict:
         "seconds": seconds,
         "pixel": (float(pixel.p_star[0]), float(pixel.alpha[0])),
         "window_error": cell.window_error(k0, rho[k0]),
+    }
+
+
+def path_states(grid: int, work: float, samples: int, window: float) -> dict:
+    """The example cell loaded along the check's own approaches (``adhesive_path.approaches``,
+    ``samples`` of them up to the model's top load), each state settled by ``ReciprocalCell``
+    from the one before; an asperity joins where its tip's gap under the settled state is
+    below 0 (its edge then found from 3 spacings up). Returns per state (approach, P*, alpha,
+    touching), the discs solved, the seconds, and the point-by-point path's P* and alpha."""
+    from metainterface.validation.adhesive_bem import _apply
+    from metainterface.validation.adhesive_path import approaches, jkr_path
+
+    design, hm, _, _, dist = _example_cell(grid)
+    model = mi.Independent(adhesion=work)
+    deltas = approaches(design, model, float(model.model_curve(design).p_star_max), samples)
+    dx, own, n = hm.spacing, hm.owner, design.gamma.size
+    tips = np.array([np.argmin(np.where(own == k, dist, np.inf)) for k in range(n)])
+    z_tip = hm.heights.reshape(-1)[tips]
+    # the windows reach past the largest rigid-overlap radius at the last approach, by half
+    # again (adhesion holds the contact wider) and the fit's window
+    overlap = np.maximum(deltas[-1] + z_tip, 0.0)
+    shape = 1.0 / (2.0 * 1.0 ** (design.gamma - 1))  # c_k of z = -(h + c_k r^gamma), R = 1
+    radius = (overlap / shape) ** (1.0 / design.gamma)
+    reach = np.ceil(1.5 * radius / dx + window + 3).astype(int)  # points, per asperity
+    t0 = time.perf_counter()
+    cell = ReciprocalCell(grid, work, window, reach)
+    rho = np.zeros(n)
+    touching = np.zeros(0, dtype=int)
+    states = []
+    for c in deltas:
+        force = 0.0
+        for _ in range(n + 1):
+            if touching.size:
+                rho, force = cell.settle(float(c), rho, touching)
+                u = _apply(cell.coupled(float(c), rho, touching)[None], cell.fwd)[0].numpy()
+                gap = u.reshape(-1)[tips] - z_tip - c
+            else:
+                gap = -z_tip - c
+            new = np.setdiff1d(np.flatnonzero(gap < 0), touching)
+            if not new.size:
+                break
+            rho[new] = window * dx
+            touching = np.union1d(touching, new)
+        alpha = float(np.sum(math.pi * rho[touching] ** 2)) / hm.cell_side**2
+        states.append((float(c), force / hm.cell_side**2, alpha, touching.size))
+    seconds = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    pixel = jkr_path(hm.heights, hm.cell_side, work, deltas)
+    return {
+        "states": states,
+        "discs": len(cell.cache),
+        "seconds": seconds,
+        "pixel": (pixel.p_star, pixel.alpha),
+        "pixel_seconds": time.perf_counter() - t1,
     }
 
 
@@ -516,7 +585,40 @@ def main() -> None:
         metavar="APPROACH",
         help="the example cell, each edge from its own asperity's family, instead",
     )
+    ap.add_argument(
+        "--path",
+        type=int,
+        default=None,
+        metavar="SAMPLES",
+        help="the example cell along the check's approaches, instead",
+    )
     args = ap.parse_args()
+    if args.path:
+        runs = {g: path_states(g, args.works[0], args.path, args.window) for g in args.grids}
+        for g, r in runs.items():
+            print(
+                f"{g}^2: {len(r['states'])} states, {r['discs']} discs in {r['seconds']:.1f} s "
+                f"(the point-by-point path: {r['pixel_seconds']:.1f} s)"
+            )
+        print(
+            "| approach [R] | touching | "
+            + " | ".join(f"P*, alpha at {g}^2" for g in runs)
+            + " | 2 alpha - alpha(M / 2) | point-by-point at the finest |"
+        )
+        print("| ---: " * (len(runs) + 4) + "|")
+        finest = runs[args.grids[-1]]
+        for i, (c, _, _, touch) in enumerate(finest["states"]):
+            cells = [f"{r['states'][i][1]:.4e}, {r['states'][i][2]:.5f}" for r in runs.values()]
+            rich = ""
+            if len(runs) > 1:
+                a = [r["states"][i][2] for r in runs.values()]
+                rich = f"{2 * a[-1] - a[-2]:.5f}"
+            pp, pa = finest["pixel"]
+            print(
+                f"| {c:.5f} | {touch} | " + " | ".join(cells) + f" | {rich} "
+                f"| {pp[i]:.4e}, {pa[i]:.5f} |"
+            )
+        return
     if args.reciprocal:
         print(
             "| approach [R] | grid | P* | alpha | 2 alpha - alpha(M / 2) | discs | seconds "
