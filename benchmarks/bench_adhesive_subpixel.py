@@ -37,6 +37,12 @@ a family of its own asperity alone, the others' pressures held as loads, which r
 makes independent of the approach and of those loads (``reciprocal_state``): P* and alpha
 per grid, and alpha extrapolated from each grid and the one before (at a fixed approach).
 
+``--path SAMPLES --grids 192 384`` loads the example cell along the check's own approaches
+(``adhesive_path.approaches``) with it, each asperity joining where its tip's gap falls
+below 0 and each disc alone solved once for the whole path (``path_states``): per state P*
+and alpha per grid, the extrapolated alpha, the point-by-point path's state, and the seconds
+of both.
+
 ``--ring THICKNESS ...`` measures the cheapest variant on the Hertz asperity: no fit, the
 exact differences between a disc and the disc grown by one ring (two solves a state), at
 disc radii 0.07-0.2 R; the mean error of alpha against JKR and its spread over the states.
@@ -62,8 +68,10 @@ from metainterface.validation.adhesive_bem import (
 )
 from metainterface.validation.heightmap import height_map
 
-QUICK = "--works 1e-4 --grids 64 --approaches 2"
-# (the --cell mode is not in the quick run: it is a measurement of a route, minutes long)
+# Quick mode (CI): the --path mode on a coarse grid, seconds: it goes through the most of
+# the package (the check's approaches, ``_bonded`` on windows and on the cell, ``jkr_path``);
+# the other modes are minutes long and share its pieces.
+QUICK = "--path 3 --grids 96"
 
 
 def jkr_radius(force: float, work: float) -> float:
