@@ -314,9 +314,16 @@ class ReciprocalCell:
     of the window's points (``window_error`` checks it against the whole cell).
     """
 
-    def __init__(self, grid: int, work: float, window: float, reach: int | np.ndarray) -> None:
+    def __init__(
+        self, grid: int, work: float, window: float, reach: int | np.ndarray, stride: int = 1
+    ) -> None:
         self.design, self.hm, self.off_x, self.off_y, self.dist = _example_cell(grid)
         self.grid, self.work, self.window = grid, work, window
+        # every stride-th of each asperity's distinct radii (counted from its centre) is fitted
+        self.shells = [
+            np.unique(np.round(self.dist[self.hm.owner == k], 12))[::stride]
+            for k in range(self.design.gamma.size)
+        ]
         self.side, self.dx, self.own = self.hm.cell_side, self.hm.spacing, self.hm.owner
         z = torch.as_tensor(self.hm.heights)[None]
         self.fwd = _spectral(forward_kernel(grid, self.side, z.device), torch.complex128)
@@ -441,8 +448,8 @@ class ReciprocalCell:
                 u0, u2 = np.linalg.lstsq(basis, u_ext[i][near], rcond=None)[0][:2]
                 centre = max(rho[k], window * dx)
                 for _ in range(24):  # move the window until the edge is inside it
-                    mine = (own == k) & (np.abs(dist - centre) < window * dx)
-                    radii = np.unique(np.round(dist[mine], 12))
+                    shells = self.shells[k]
+                    radii = shells[np.abs(shells - centre) < window * dx]
                     a, f0, kk, m2 = np.array([self.alone(int(k), r) for r in radii]).T
                     cf = np.polyfit(a - centre, f0 + (c - u0) * kk - u2 * m2, 3)
                     ck = np.polyfit(a - centre, kk, 3)
@@ -503,7 +510,7 @@ def reciprocal_state(grid: int, work: float, c: float, window: float) -> dict:
     }
 
 
-def path_states(grid: int, work: float, samples: int, window: float) -> dict:
+def path_states(grid: int, work: float, samples: int, window: float, stride: int = 1) -> dict:
     """The example cell loaded along the check's own approaches (``adhesive_path.approaches``,
     ``samples`` of them up to the model's top load), each state settled by ``ReciprocalCell``
     from the one before; an asperity joins where its tip's gap under the settled state is
@@ -525,7 +532,7 @@ def path_states(grid: int, work: float, samples: int, window: float) -> dict:
     radius = (overlap / shape) ** (1.0 / design.gamma)
     reach = np.ceil(1.5 * radius / dx + window + 3).astype(int)  # points, per asperity
     t0 = time.perf_counter()
-    cell = ReciprocalCell(grid, work, window, reach)
+    cell = ReciprocalCell(grid, work, window, reach, stride)
     rho = np.zeros(n)
     touching = np.zeros(0, dtype=int)
     states = []
@@ -601,9 +608,15 @@ def main() -> None:
         metavar="SAMPLES",
         help="the example cell along the check's approaches, instead",
     )
+    ap.add_argument(
+        "--stride", type=int, default=1, help="--path: fit every stride-th radius of an asperity"
+    )
     args = ap.parse_args()
     if args.path:
-        runs = {g: path_states(g, args.works[0], args.path, args.window) for g in args.grids}
+        runs = {
+            g: path_states(g, args.works[0], args.path, args.window, args.stride)
+            for g in args.grids
+        }
         for g, r in runs.items():
             print(
                 f"{g}^2: {len(r['states'])} states, {r['discs']} discs in {r['seconds']:.1f} s "
