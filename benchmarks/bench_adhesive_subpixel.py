@@ -41,7 +41,7 @@ per grid, and alpha extrapolated from each grid and the one before (at a fixed a
 (``adhesive_path.approaches``) with it, each asperity joining where its tip's gap falls
 below 0 and each disc alone solved once for the whole path (``path_states``): per state P*
 and alpha per grid, the extrapolated alpha, the point-by-point path's state, and the seconds
-of both.
+of both. ``--stride N`` fits every N-th of each asperity's distinct radii only.
 
 ``--ring THICKNESS ...`` measures the cheapest variant on the Hertz asperity: no fit, the
 exact differences between a disc and the disc grown by one ring (two solves a state), at
