@@ -42,6 +42,15 @@ from metainterface.verify.adhesive import bounded_check
 QUICK = "--works 4.2e-5 --grids 64"
 
 
+def jkr_radius(force: np.ndarray | float, work: float) -> np.ndarray | float:
+    """JKR's contact radius under ``force`` >= 0 (R = 1, E* = 1, work of adhesion w):
+    F = 4 a^3 / 3 - sqrt(8 pi w a^3) solved for a."""
+    q = 3.0 * math.pi * work
+    return ((force + q + np.sqrt(6.0 * math.pi * work * force + q * q)) / (4.0 / 3.0)) ** (
+        1.0 / 3.0
+    )
+
+
 def jkr_target(work: float) -> tuple[mi.Design, mi.Target]:
     """The Hertz cell and its JKR loading curve (63 loads up to the model's top)."""
     design = mi.Design(
@@ -50,9 +59,7 @@ def jkr_target(work: float) -> tuple[mi.Design, mi.Target]:
     side = height_map(design, 16).cell_side
     top = float(mi.Independent(adhesion=work).model_curve(design).p_star_max)
     p = np.linspace(0.0, top, 64)
-    f = p * side**2
-    q = 3.0 * math.pi * work
-    a = ((f + q + np.sqrt(6.0 * math.pi * work * f + q * q)) / (4.0 / 3.0)) ** (1.0 / 3.0)
+    a = jkr_radius(p * side**2, work)
     return design, mi.Target(p_star=p, alpha=math.pi * a * a / side**2, name="jkr")
 
 

@@ -51,6 +51,7 @@ disc radii 0.07-0.2 R; the mean error of alpha against JKR and its spread over t
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import time
 
@@ -58,7 +59,9 @@ import numpy as np
 import torch
 
 import metainterface as mi
+from bench_adhesive_convergence import jkr_radius  # JKR's a(F), written there
 from metainterface.physics import CellSettings
+from metainterface.physics.sneddon import shape_constant
 from metainterface.validation.adhesive_bem import (
     PRECONDITIONER_DTYPE,
     _bonded,
@@ -74,17 +77,35 @@ from metainterface.validation.heightmap import height_map
 QUICK = "--path 3 --grids 96"
 
 
-def jkr_radius(force: float, work: float) -> float:
-    """JKR's contact radius under ``force`` (R = 1, E* = 1, work w)."""
-    q = 3.0 * math.pi * work
-    return ((force + q + math.sqrt(6.0 * math.pi * work * force + q * q)) / (4.0 / 3.0)) ** (
-        1.0 / 3.0
+def cell_kernels(grid: int, side: float) -> tuple[torch.Tensor, torch.Tensor]:
+    """The periodic cell's compliance and preconditioner, as ``_bonded`` takes them."""
+    device = torch.device("cpu")
+    return (
+        _spectral(forward_kernel(grid, side, device), torch.complex128),
+        _spectral(inverse_kernel(grid, side, device), PRECONDITIONER_DTYPE),
     )
 
 
-def disc_family(grid: int) -> tuple[np.ndarray, np.ndarray, float, float]:
+def pair_solver(heights: np.ndarray, fwd: torch.Tensor, stiff: torch.Tensor, tolerance: float):
+    """``solve(sets, start=None)``: the points ``sets`` (M, M) bool of the surface
+    ``heights`` (M, M) bonded (``_bonded``, compliance ``fwd``, preconditioner ``stiff``),
+    at c = 0 and for a unit approach, so that the pressure at any approach c is
+    p[0] + c p[1]. Returns (p (2, M, M), residual (2,)); ``start`` (2, M, M) a warm start."""
+    z = torch.as_tensor(heights)
+    pair = torch.stack([z, torch.zeros_like(z)])
+    shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
+
+    def solve(sets: np.ndarray, start: torch.Tensor | None = None):
+        mask = torch.as_tensor(sets)[None].expand(2, -1, -1)
+        first = torch.zeros_like(pair) if start is None else start * mask
+        return _bonded(pair, shift, mask, fwd, first, tolerance, 5000, stiff)
+
+    return solve
+
+
+def disc_family(grid: int):
     """The Hertz cell on ``grid``^2: (distance of each point to the centre, distinct
-    radii below a quarter of the side, spacing, side)."""
+    radii below a quarter of the side, spacing, side, ``pair_solver`` of its heights)."""
     design = mi.Design(
         gamma=np.array([2.0]), h=np.array([0.0]), settings=CellSettings(n_asperities=1)
     )
@@ -93,28 +114,23 @@ def disc_family(grid: int) -> tuple[np.ndarray, np.ndarray, float, float]:
     x = np.arange(grid) * hm.spacing
     dist = np.hypot(x[None, :] - centre[0], x[:, None] - centre[1])
     radii = np.unique(np.round(dist[dist < hm.cell_side / 4], 12))
-    return dist, radii, hm.spacing, hm.cell_side
+    z = -0.5 * dist**2  # R = 1, tips at 0 (as ``height_map``)
+    solve = pair_solver(z, *cell_kernels(grid, hm.cell_side), tolerance=1e-12)
+    return dist, radii, hm.spacing, hm.cell_side, solve
 
 
 def equilibrium(grid: int, work: float, approaches: np.ndarray, window: float) -> list:
     """(approach, a / dx, error of alpha against JKR, discs solved) per approach."""
-    dist, radii, dx, side = disc_family(grid)
-    z = torch.as_tensor(-0.5 * dist**2)[None]  # R = 1, tips at 0 (as ``height_map``)
-    fwd = _spectral(forward_kernel(grid, side, z.device), torch.complex128)
-    stiff = _spectral(inverse_kernel(grid, side, z.device), PRECONDITIONER_DTYPE)
-    heights = torch.cat([z, torch.zeros_like(z)])
-    shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
+    dist, radii, dx, side, bonded = disc_family(grid)
     cache: dict[int, tuple[float, float, float]] = {}
 
     def solve(j: int) -> tuple[float, float, float]:  # (a, F_0, k) of disc j
         if j not in cache:
-            disc = torch.as_tensor(dist <= radii[j] + 1e-12)[None].expand(2, -1, -1)
-            p, res = _bonded(
-                heights, shift, disc, fwd, torch.zeros_like(heights), 1e-12, 5000, stiff
-            )
+            disc = dist <= radii[j] + 1e-12
+            p, res = bonded(disc)
             assert bool((res <= 1e-12).all()), res
             f = p.sum(dim=(1, 2)).numpy() * dx * dx
-            cache[j] = (math.sqrt(float(disc[0].sum()) / math.pi) * dx, float(f[0]), float(f[1]))
+            cache[j] = (math.sqrt(float(disc.sum()) / math.pi) * dx, float(f[0]), float(f[1]))
         return cache[j]
 
     k_c = math.sqrt(2.0 * work)
@@ -155,18 +171,13 @@ def ring_states(grid: int, work: float, thickness: float) -> np.ndarray:
     at which |dF_0 + c dk| = sqrt(dA |dk|) K_c, and the state (F, pi a^2) there with a at
     the ring's middle. Returns (a / dx, error of alpha against JKR) (S, 2) for discs of
     radius 0.07-0.2 R in steps of 0.37 dx."""
-    dist, _, dx, side = disc_family(grid)
-    z = torch.as_tensor(-0.5 * dist**2)[None]
-    fwd = _spectral(forward_kernel(grid, side, z.device), torch.complex128)
-    stiff = _spectral(inverse_kernel(grid, side, z.device), PRECONDITIONER_DTYPE)
-    heights = torch.cat([z, torch.zeros_like(z)])
-    shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
+    dist, _, dx, _, bonded = disc_family(grid)
 
     def solve(r: float) -> tuple[int, float, float]:
-        disc = torch.as_tensor(dist <= r + 1e-12)[None].expand(2, -1, -1)
-        p, _ = _bonded(heights, shift, disc, fwd, torch.zeros_like(heights), 1e-12, 5000, stiff)
+        disc = dist <= r + 1e-12
+        p, _ = bonded(disc)
         f = p.sum(dim=(1, 2)).numpy() * dx * dx
-        return int(disc[0].sum()), float(f[0]), float(f[1])
+        return int(disc.sum()), float(f[0]), float(f[1])
 
     out = []
     for r in np.arange(0.07, 0.2, 0.37 * dx):
@@ -182,9 +193,11 @@ def ring_states(grid: int, work: float, thickness: float) -> np.ndarray:
     return np.array(out)
 
 
+@functools.cache
 def _example_cell(grid: int):
     """The package's nine-asperity example cell on ``grid``^2: (design, height map, each
-    point's offsets (x, y) from its asperity's centre and distance to it)."""
+    point's offsets (x, y) from its asperity's centre and distance to it). Made once a grid:
+    callers only read it."""
     import json
     from pathlib import Path
 
@@ -216,14 +229,11 @@ def cell_state(
     n = np.bincount(own[pixel.contact[0].numpy()], minlength=design.gamma.size)
     touching = np.flatnonzero(n > 0)
     rho = np.sqrt(n / math.pi) * dx
-    fwd = _spectral(forward_kernel(grid, side, z.device), torch.complex128)
-    stiff = _spectral(inverse_kernel(grid, side, z.device), PRECONDITIONER_DTYPE)
-    heights = torch.cat([z, torch.zeros_like(z)])
-    shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
+    bonded = pair_solver(hm.heights, *cell_kernels(grid, side), tolerance=1e-12)
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
     radius, force0, stiffness = [], [], []
-    p = torch.zeros_like(heights)
+    p = None
     # "shells": each asperity's distinct radii in the window, in an order of its own, so
     # every radius is drawn (as the single asperity's family) and the nine are unrelated
     shells = [
@@ -242,11 +252,9 @@ def cell_state(
         else:
             r = rho + rng.uniform(-window, window, n.size) * dx
         r = np.where(n > 0, np.maximum(r, dx), -1)
-        sets = torch.as_tensor(dist <= r[own] + 1e-12)[None]
-        p, _res = _bonded(heights, shift, sets.expand(2, -1, -1), fwd, p * sets, 1e-12, 5000, stiff)
-        radius.append(
-            np.sqrt(np.bincount(own[sets[0].numpy()], minlength=n.size) / math.pi) * dx - rho
-        )
+        sets = dist <= r[own] + 1e-12
+        p, _ = bonded(sets, p)
+        radius.append(np.sqrt(np.bincount(own[sets], minlength=n.size) / math.pi) * dx - rho)
         per = [
             np.bincount(own.ravel(), weights=p[i].numpy().ravel(), minlength=n.size) for i in (0, 1)
         ]
@@ -325,19 +333,17 @@ class ReciprocalCell:
             for k in range(self.design.gamma.size)
         ]
         self.side, self.dx, self.own = self.hm.cell_side, self.hm.spacing, self.hm.owner
-        z = torch.as_tensor(self.hm.heights)[None]
-        self.fwd = _spectral(forward_kernel(grid, self.side, z.device), torch.complex128)
-        self.stiff = _spectral(inverse_kernel(grid, self.side, z.device), PRECONDITIONER_DTYPE)
-        self.heights = torch.cat([z, torch.zeros_like(z)])
-        self.shift = torch.tensor([0.0, 1.0], dtype=torch.float64).reshape(2, 1, 1)
+        self.fwd, stiff = cell_kernels(grid, self.side)
+        self.bonded = pair_solver(self.hm.heights, self.fwd, stiff, tolerance=1e-12)
         side_points = grid // self.design.settings.n_side
         reaches = np.broadcast_to(np.asarray(reach), self.design.gamma.shape)
         self.m = [min(side_points, 2 * int(r)) + 2 for r in reaches]  # each disc's window
         self.kernel = torch.fft.irfft2(
-            forward_kernel(grid, self.side, z.device)[0].to(torch.complex128), s=(grid, grid)
+            forward_kernel(grid, self.side, torch.device("cpu"))[0].to(torch.complex128),
+            s=(grid, grid),
         )
         self.kernels: dict[int, tuple[torch.Tensor, torch.Tensor]] = {}
-        self.windows: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self.windows: dict[int, tuple] = {}
         self.cache: dict[tuple[int, float], tuple[float, float, float, float]] = {}
 
     def _kernels(self, m: int) -> tuple[torch.Tensor, torch.Tensor]:
@@ -354,8 +360,9 @@ class ReciprocalCell:
             )
         return self.kernels[m]
 
-    def _window(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Disc k's window: heights, distances to its centre (inf off it), its own points."""
+    def _window(self, k: int) -> tuple:
+        """Disc k's window: distances to its centre (inf off it), its own points, and the
+        ``pair_solver`` of its heights on the window's kernels."""
         if k not in self.windows:
             m, dist, own = self.m[k], self.dist, self.own
             cy, cx = np.unravel_index(np.argmin(np.where(own == k, dist, np.inf)), dist.shape)
@@ -366,21 +373,20 @@ class ReciprocalCell:
             mine = np.zeros((2 * m, 2 * m), dtype=bool)
             zw[:m, :m], dw[:m, :m] = self.hm.heights[rows, cols], dist[rows, cols]
             mine[:m, :m] = own[rows, cols] == k
-            self.windows[k] = (zw, dw, mine)
+            # to 1e-9: the fits read the sums to ~1e-6 (a fifth fewer steps than 1e-12)
+            solve = pair_solver(zw, *self._kernels(m), tolerance=1e-9)
+            self.windows[k] = (dw, mine, solve)
         return self.windows[k]
 
     def sums(self, k: int, r: float) -> tuple[float, float, float, float]:
         """Disc k of radius r alone, on its window: (a, F_0k, k_k, M2_k)."""
-        zw, dw, mine = self._window(k)
-        m, dx = self.m[k], self.dx
-        fwd_w, stiff_w = self._kernels(m)
-        disc = torch.as_tensor(mine & (dw <= r + 1e-12))[None].expand(2, -1, -1)
-        hw = torch.stack([torch.as_tensor(zw), torch.zeros(2 * m, 2 * m, dtype=torch.float64)])
-        # to 1e-9: the fits read the sums to ~1e-6 (a fifth fewer steps than the check's 1e-12)
-        p, _ = _bonded(hw, self.shift, disc, fwd_w, torch.zeros_like(hw), 1e-9, 5000, stiff_w)
+        dw, mine, solve = self._window(k)
+        dx = self.dx
+        disc = mine & (dw <= r + 1e-12)
+        p, _ = solve(disc)
         unit = p[1].numpy()
         return (
-            math.sqrt(float(disc[0].sum()) / math.pi) * dx,
+            math.sqrt(float(disc.sum()) / math.pi) * dx,
             float(p[0].sum()) * dx * dx,
             float(unit.sum()) * dx * dx,
             float((unit * np.where(mine, dw, 0.0) ** 2).sum()) * dx * dx,
@@ -395,17 +401,7 @@ class ReciprocalCell:
     def window_error(self, k: int, r: float) -> float:
         """Largest relative difference of ``sums``' three sums against the whole cell."""
         own, dist, dx = self.own, self.dist, self.dx
-        disc = torch.as_tensor((own == k) & (dist <= r + 1e-12))[None].expand(2, -1, -1)
-        p, _ = _bonded(
-            self.heights,
-            self.shift,
-            disc,
-            self.fwd,
-            torch.zeros_like(self.heights),
-            1e-12,
-            5000,
-            self.stiff,
-        )
+        p, _ = self.bonded((own == k) & (dist <= r + 1e-12))
         unit = p[1].numpy()
         whole = np.array([float(p[0].sum()), float(unit.sum()), float((unit * dist**2).sum())])
         return float(np.max(np.abs(np.array(self.sums(k, r)[1:]) / (whole * dx * dx) - 1)))
@@ -413,17 +409,7 @@ class ReciprocalCell:
     def coupled(self, c: float, rho: np.ndarray, touching: np.ndarray) -> torch.Tensor:
         """(M, M) the pressure of the touching discs (radii ``rho``) bonded at approach c."""
         own, dist = self.own, self.dist
-        sets = torch.as_tensor(np.isin(own, touching) & (dist <= rho[own] + 1e-12))[None]
-        p, _ = _bonded(
-            self.heights,
-            self.shift,
-            sets.expand(2, -1, -1),
-            self.fwd,
-            torch.zeros_like(self.heights),
-            1e-12,
-            5000,
-            self.stiff,
-        )
+        p, _ = self.bonded(np.isin(own, touching) & (dist <= rho[own] + 1e-12))
         return p[0] + c * p[1]
 
     def settle(self, c: float, rho: np.ndarray, touching: np.ndarray) -> tuple[np.ndarray, float]:
@@ -528,8 +514,8 @@ def path_states(grid: int, work: float, samples: int, window: float, stride: int
     # the windows reach past the largest rigid-overlap radius at the last approach, by half
     # again (adhesion holds the contact wider) and the fit's window
     overlap = np.maximum(deltas[-1] + z_tip, 0.0)
-    shape = 1.0 / (2.0 * 1.0 ** (design.gamma - 1))  # c_k of z = -(h + c_k r^gamma), R = 1
-    radius = (overlap / shape) ** (1.0 / design.gamma)
+    shape = shape_constant(torch.as_tensor(design.gamma), design.settings.radius).numpy()
+    radius = (overlap / shape) ** (1.0 / design.gamma)  # z = -(h + c_k r^gamma)
     reach = np.ceil(1.5 * radius / dx + window + 3).astype(int)  # points, per asperity
     t0 = time.perf_counter()
     cell = ReciprocalCell(grid, work, window, reach, stride)
