@@ -41,7 +41,8 @@ per grid, and alpha extrapolated from each grid and the one before (at a fixed a
 (``adhesive_path.approaches``) with it, each asperity joining where its tip's gap falls
 below 0 and each disc alone solved once for the whole path (``path_states``): per state P*
 and alpha per grid, the extrapolated alpha, the point-by-point path's state, and the seconds
-of both. ``--stride N`` fits every N-th of each asperity's distinct radii only.
+of both. ``--stride N`` fits every N-th of each asperity's distinct radii only; ``--busy N``
+runs the path beside N CPU-bound processes.
 
 ``--ring THICKNESS ...`` measures the cheapest variant on the Hertz asperity: no fit, the
 exact differences between a disc and the disc grown by one ring (two solves a state), at
@@ -597,12 +598,26 @@ def main() -> None:
     ap.add_argument(
         "--stride", type=int, default=1, help="--path: fit every stride-th radius of an asperity"
     )
+    ap.add_argument(
+        "--busy", type=int, default=0, help="--path: beside this many CPU-bound processes"
+    )
     args = ap.parse_args()
     if args.path:
-        runs = {
-            g: path_states(g, args.works[0], args.path, args.window, args.stride)
-            for g in args.grids
-        }
+        import subprocess
+        import sys
+
+        spin = [sys.executable, "-c", "while True: pass"]
+        busy = [subprocess.Popen(spin) for _ in range(args.busy)]
+        try:
+            runs = {
+                g: path_states(g, args.works[0], args.path, args.window, args.stride)
+                for g in args.grids
+            }
+        finally:
+            for proc in busy:
+                proc.kill()
+        if args.busy:
+            print(f"beside {args.busy} busy processes:")
         for g, r in runs.items():
             print(
                 f"{g}^2: {len(r['states'])} states, {r['discs']} discs in {r['seconds']:.1f} s "
