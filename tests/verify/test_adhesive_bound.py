@@ -42,8 +42,75 @@ def _error(alpha, p, target):
     return float(np.linalg.norm(alpha - t) / np.linalg.norm(t))
 
 
-@pytest.mark.parametrize("grid", [64, pytest.param(128, marks=pytest.mark.long)])
-def test_the_bound_holds_against_jkr_and_a_finer_grid(hertz, grid):
+@pytest.mark.parametrize("work", [W, 1e-4, 5e-4])
+def test_the_default_check_of_a_hertz_asperity_is_within_its_bound_of_jkr(work):
+    # the disc criterion extrapolated over three grids (the default check): its curve against
+    # the JKR closed form written here, whose error the check must bound and keep within a
+    # quarter of the 2 % asked (issue 52, item 3)
+    design, target = _jkr(work)
+    b = bounded_check(
+        design, target, mi.Independent(adhesion=work), grid=None, loads=8, max_error=0.02
+    )
+    s = b.solved
+    assert any("family of bonded discs" in n for n in s.notes)
+    assert s.p_star.size >= 8
+    true = _error(s.alpha_bem, s.p_star, target)
+    assert 0 < true <= b.accuracy <= 0.25 * 0.02
+    assert any("own error, from the extrapolations" in n for n in s.notes)
+
+
+def _finer_extrapolation(design, target, model, grid, loads):
+    """The disc criterion's curve extrapolated from 2 M and 4 M: a grid finer than any the
+    check at M took, along the same approaches."""
+    from metainterface.verify.adhesive_discs import disc_check
+
+    return disc_check(design, target, model, grids=(grid, 2 * grid, 4 * grid), loads=loads)[0]
+
+
+@pytest.mark.long
+@pytest.mark.parametrize("seed", [3, 5])
+def test_the_disc_check_bound_holds_against_a_finer_grid_on_a_cell(seed):
+    # four asperities snapping in one after another (cells not tuned on: the criterion was
+    # developed on the package's example cell): the check on 64^2-256^2 (32-128 points an
+    # asperity) against the same criterion extrapolated from 256^2 and 512^2, read at the
+    # check's loads clear of both curves' snap-ins
+    from metainterface.verify.adhesive import read_across_jumps
+
+    design, target, model = _cell(seed)
+    b = bounded_check(design, target, model, grid=256, loads=8, max_error=0.02)
+    assert b.grids == (64, 128, 256)
+    s = b.solved
+    assert any("family of bonded discs" in n for n in s.notes)
+    ref = _finer_extrapolation(design, target, model, 128, 8)
+    other = read_across_jumps(s.p_star, ref.p_star, ref.alpha_bem, ref.snap_ins)
+    seen = np.isfinite(other)
+    assert seen.sum() >= 4
+    t = np.interp(s.p_star[seen], target.p_star, target.alpha)
+    true = np.linalg.norm(s.alpha_bem[seen] - other[seen]) / np.linalg.norm(t)
+    assert true <= b.accuracy
+
+
+def test_a_disc_solve_that_does_not_converge_is_an_error_not_a_fallback(hertz, monkeypatch):
+    from metainterface.validation import adhesive_discs
+
+    design, target = hertz
+    monkeypatch.setattr(adhesive_discs, "MAX_ITER", 1)
+    with pytest.raises(mi.MetainterfaceError, match="disc criterion.*did not converge"):
+        bounded_check(
+            design, target, mi.Independent(adhesion=W), grid=None, loads=4, max_error=0.02
+        )
+
+
+def test_a_grid_too_coarse_for_the_disc_criterion_says_it_checks_point_by_point(hertz):
+    design, target = hertz
+    b = bounded_check(design, target, mi.Independent(adhesion=W), grid=64, loads=4, max_error=0.02)
+    assert any("does not suit the disc criterion" in n for n in b.solved.notes)
+    assert b.grids == (32, 64)
+
+
+@pytest.mark.parametrize("grid", [64])
+def test_the_point_by_point_bound_holds_against_jkr_and_a_finer_grid(hertz, grid):
+    # a grid given too coarse for the disc criterion: the point-by-point BEM on it and half
     design, target = hertz
     model = mi.Independent(adhesion=W)
     b = bounded_check(design, target, model, grid=grid, loads=6, max_error=0.02)

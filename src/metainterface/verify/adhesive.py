@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
@@ -64,6 +64,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
+from metainterface.validation.adhesive_discs import DiscCriterionError
 from metainterface.validation.adhesive_path import (  # noqa: F401  (re-exported)
     APPROACHES_PER_LOAD,
     FINEST,
@@ -73,6 +74,8 @@ from metainterface.validation.adhesive_path import (  # noqa: F401  (re-exported
     clear_of_snap_ins,
     rising_branch,
 )
+from metainterface.verify._adhesive_curve import AdhesiveSolved, read_across_jumps
+from metainterface.verify.adhesive_discs import COARSEST, disc_check
 
 #: Grid points per lattice cell side of the default adhesive check's first fine grid (the
 #: adhesionless check's, 384^2 for N = 9), and the most it doubles to (768^2 for N = 9): the
@@ -87,21 +90,6 @@ ORDER = 1.0
 #: check's true error (a Hertz asperity against the JKR closed form, grids up to ``FINEST``:
 #: ``benchmarks/bench_adhesive_convergence.py``); above it the check says so.
 VALIDATED_WORK = 5e-4
-
-
-@dataclass(frozen=True)
-class AdhesiveSolved:
-    """The adhesive check's BEM path at the states a rising force reaches inside the
-    target's range: p_star, alpha_bem, alpha_model (K,); device, wall time [s], notes;
-    snap_ins (J, 2): the BEM's own snap-in loads, [lo, hi] P*, where it jumps."""
-
-    p_star: np.ndarray
-    alpha_bem: np.ndarray
-    alpha_model: np.ndarray
-    device: str
-    seconds: float
-    notes: tuple[str, ...]
-    snap_ins: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
 
 def solve_adhesive(
@@ -173,31 +161,6 @@ def accuracy(fine: AdhesiveSolved, coarse: AdhesiveSolved, target: Target) -> fl
     return float(np.linalg.norm(diff)) / norm / (2.0**ORDER - 1.0)
 
 
-def read_across_jumps(
-    x: np.ndarray, xp: np.ndarray, fp: np.ndarray, jumps: np.ndarray
-) -> np.ndarray:
-    """(K,) a load-controlled curve (states ``xp``, ``fp`` (S,), sorted) read at loads ``x``
-    (K,): linear within each piece between its ``jumps`` ((J, 2): each snap-in's load
-    between lo and hi) and extrapolated from the piece's end states up to its jumps (one
-    state: its value), never across a jump (a straight line there would read a snap-in as
-    a slope); NaN within a jump's bounds (the curve may read either side there), outside
-    ``xp``'s range and in a piece without states."""
-    out = np.full(x.shape, np.nan)
-    cuts = np.sort(0.5 * (jumps[:, 0] + jumps[:, 1]))
-    piece_x = np.searchsorted(cuts, x)
-    piece_p = np.searchsorted(cuts, xp)
-    within = (x >= xp[0]) & (x <= xp[-1]) & ~at_snap_ins(x, jumps)
-    for j in np.unique(piece_x[within]):
-        at = within & (piece_x == j)
-        xs, ys = xp[piece_p == j], fp[piece_p == j]
-        if xs.size == 1:
-            out[at] = ys[0]
-        elif xs.size > 1:
-            k = np.clip(np.searchsorted(xs, x[at]), 1, xs.size - 1)
-            out[at] = ys[k - 1] + (ys[k] - ys[k - 1]) * (x[at] - xs[k - 1]) / (xs[k] - xs[k - 1])
-    return out
-
-
 @dataclass(frozen=True)
 class BoundedCheck:
     """The adhesive check at its chosen grid: the solve there, the grid, its own error
@@ -244,6 +207,22 @@ def bounded_check(
 
     start = time.perf_counter()
     fine_grid = GRID_START * n if grid is None else check_grid(grid, s)
+    bound = BOUND_SHARE * max_error
+    fallback = (
+        f"the grid {fine_grid}^2 does not suit the disc criterion (its coarsest grid, a "
+        f"quarter of it, must be a multiple of {n} with at least {COARSEST} points an "
+        "asperity): the check is the point-by-point BEM's"
+    )
+    if fine_grid // 4 >= COARSEST * n and fine_grid % (4 * n) == 0:
+        try:
+            return _bounded_discs(
+                design, target, model, fine_grid, grid is None, loads, max_error, device, start
+            )
+        except DiscCriterionError as exc:
+            fallback = (
+                f"the disc criterion does not apply to this design ({exc}): the check is the "
+                "point-by-point BEM's"
+            )
     coarse_grid = half(fine_grid)
     # The two grids at once, on two Python threads (each one torch thread; a solve's FFTs
     # and CG steps release the GIL), each path in two chains (``rising_branch``): on two
@@ -254,7 +233,6 @@ def bounded_check(
         fine = later()
     grids = [coarse_grid, fine_grid]
     acc = accuracy(fine, coarse, target)
-    bound = BOUND_SHARE * max_error
 
     def worth(m: int) -> bool:  # the bound within reach by GRID_MAX at the assumed order
         return acc * (m / (GRID_MAX * n)) ** ORDER <= bound and 2 * m <= GRID_MAX * n
@@ -276,7 +254,7 @@ def bounded_check(
             + ": its verdict holds to that"
         )
     )
-    notes = (*fine.notes, note)
+    notes = (*fine.notes, note) + ((fallback,) if fallback else ())
     if model.adhesion > VALIDATED_WORK:
         notes += (
             f"w = {model.adhesion:.3g} E* R is above the {VALIDATED_WORK:g} E* R up to which "
@@ -284,3 +262,67 @@ def bounded_check(
         )
     fine = replace(fine, notes=notes)
     return BoundedCheck(fine, fine_grid, acc, tuple(grids), time.perf_counter() - start)
+
+
+def _bounded_discs(
+    design: Design,
+    target: Target,
+    model: ForwardModel,
+    fine_grid: int,
+    auto: bool,
+    loads: int,
+    max_error: float,
+    device: str,
+    start: float,
+) -> BoundedCheck:
+    """``bounded_check`` by the disc criterion (``verify.adhesive_discs``): on fine_grid /
+    4, / 2 and fine_grid; where ``auto``, doubled while its own error is above the bound or
+    the criterion finds no edge on the coarsest grid (a contact a few spacings wide), up to
+    ``GRID_MAX`` n. The paths of grids already solved are reused."""
+    n = design.settings.n_side
+    bound = BOUND_SHARE * max_error
+
+    def grids(m: int) -> tuple[int, int, int]:
+        return (m // 4, m // 2, m)
+
+    paths: dict = {}
+    tried: list[int] = []
+    while True:
+        tried.append(fine_grid)
+        finer = auto and 2 * fine_grid <= GRID_MAX * n
+        try:
+            solved, acc, _ = disc_check(
+                design,
+                target,
+                model,
+                grids=grids(fine_grid),
+                loads=loads,
+                device=device,
+                known=paths,
+            )
+        except DiscCriterionError:
+            if not finer:
+                raise
+            fine_grid *= 2
+            continue
+        if acc <= bound or not finer:
+            break
+        fine_grid *= 2
+    g = grids(fine_grid)
+    note = (
+        f"the adhesive check's own error, from the extrapolations of ({g[0]}^2, {g[1]}^2) and "
+        f"({g[1]}^2, {g[2]}^2): {100 * acc:.2g} %"
+        + (
+            f" (within a quarter of the {100 * max_error:g} % asked)"
+            if acc <= bound
+            else f", above a quarter of the {100 * max_error:g} % asked: its verdict holds to that"
+        )
+    )
+    notes = (*solved.notes, note)
+    if model.adhesion > VALIDATED_WORK:
+        notes += (
+            f"w = {model.adhesion:.3g} E* R is above the {VALIDATED_WORK:g} E* R up to which "
+            "the check's own error estimate was shown to hold against JKR",
+        )
+    solved = replace(solved, notes=notes)
+    return BoundedCheck(solved, fine_grid, acc, tuple(sorted(paths)), time.perf_counter() - start)
