@@ -32,7 +32,7 @@ from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
-from metainterface.validation.adhesive_discs import DiscCell, disc_path
+from metainterface.validation.adhesive_discs import DiscCell, DiscCriterionError, disc_path
 from metainterface.validation.adhesive_path import (
     APPROACHES_PER_LOAD,
     AdhesivePath,
@@ -83,7 +83,12 @@ def _curve(
     both grids touching alike) and its snap-ins (J, 2)."""
     p, a, same, touching = _extrapolated(fine, coarse)
     running = np.maximum.accumulate(np.where(same, p, -np.inf))
-    snaps = own_snap_ins(p, touching)
+    # the snap-ins from every state, those left out read between their neighbours
+    placed = np.isfinite(p)
+    if not placed.any():
+        raise DiscCriterionError("the disc criterion placed no state of the path")
+    at = np.arange(p.size)
+    snaps = own_snap_ins(np.interp(at, at[placed], p[placed]), touching)
     keep = (
         same
         & (p >= running)
@@ -126,9 +131,10 @@ def disc_check(
     done = threading.Event()
 
     def path(i: int) -> AdhesivePath:
-        # the coarsest grid only estimates the error: a state it cannot place is left out
+        # a state the criterion cannot place on a grid (an asperity just touched, its contact
+        # a few spacings wide) is left out of the curves it enters
         if grids[i] not in known:
-            known[grids[i]] = disc_path(cells[i], deltas, stop_above=stop, skip_failures=i == 0)
+            known[grids[i]] = disc_path(cells[i], deltas, stop_above=stop, skip_failures=True)
         return known[grids[i]]
 
     def coarse_then_help() -> list[AdhesivePath]:
@@ -150,13 +156,20 @@ def disc_check(
         finally:
             done.set()
         coarsest, middle = helper()
+    k = min(finest.p_star.size, middle.p_star.size)
+    unplaced = int((~np.isfinite(finest.p_star[:k]) | ~np.isfinite(middle.p_star[:k])).sum())
+    if unplaced > k // 4:
+        raise DiscCriterionError(
+            f"the disc criterion could not place {unplaced} of {k} states on {grids[1]}^2 "
+            f"and {grids[2]}^2 (contacts a few spacings wide)"
+        )
     p, a, keep, snaps = _curve(finest, middle, design, model, top)
     inside = (p >= target.p_star[0] * (1 - 1e-9)) & (p <= target.p_star_max * (1 + 1e-9))
     keep &= inside
     if not keep.any():
         raise MetainterfaceError(
             "the adhesive check (disc criterion) reached no load inside the target's range on "
-            f"its rising branch (up to P* = {float(np.max(p, initial=0.0)):.3g})"
+            f"its rising branch (up to P* = {float(np.nanmax(p, initial=0.0)):.3g})"
         )
     lp, la, lkeep, lsnaps = _curve(middle, coarsest, design, model, top)
     other = (
@@ -182,6 +195,11 @@ def disc_check(
         f"{grids[2]}^2 ({m[1]} and {m[2]} points an asperity); {int(keep.sum())} of "
         f"{deltas.size} approaches on the rising branch",
     ]
+    if unplaced:
+        notes.append(
+            f"{unplaced} of {k} approaches left out: an asperity's contact there is too few "
+            "spacings wide for the disc criterion on these grids (just after it touched)"
+        )
     if p[keep][-1] < top * (1 - 0.25):
         notes.append(
             f"the adhesive BEM's rising branch reaches P* = {p[keep][-1]:.4g} in the target's "
