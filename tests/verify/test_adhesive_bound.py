@@ -95,7 +95,7 @@ def test_a_disc_solve_that_does_not_converge_is_an_error_not_a_fallback(hertz, m
 
     design, target = hertz
     monkeypatch.setattr(adhesive_discs, "MAX_ITER", 1)
-    with pytest.raises(mi.MetainterfaceError, match="disc criterion.*did not converge"):
+    with pytest.raises(mi.MetainterfaceError, match=r"disc criterion.*did not converge"):
         bounded_check(
             design, target, mi.Independent(adhesion=W), grid=None, loads=4, max_error=0.02
         )

@@ -65,6 +65,8 @@ WINDOW = 3.0
 #: cell a stride of 3 moves the two-grid alpha by at most 0.07 % against every radius, at a
 #: third of the cost (benchmarks/results/adhesion.md).
 STRIDE = 3
+#: Fewer strided radii than this in a fit's window, and the fit takes every radius there.
+MIN_FIT = 8
 #: Relative residual of the discs' bonded solves (the fits read their sums to ~1e-6), and of
 #: the coupled solves of the touching discs.
 FAMILY_TOLERANCE = 1e-9
@@ -167,10 +169,10 @@ class DiscCell:
             [int(np.argmin(np.where(self.own == k, self.dist, np.inf))) for k in range(self.n)]
         )
         self.z_tip = self.heights.reshape(-1)[self.tips]
-        # every stride-th of each asperity's distinct radii, counted from its tip
-        self.shells = [
-            np.unique(np.round(self.dist[self.own == k], 12))[::stride] for k in range(self.n)
-        ]
+        # each asperity's distinct radii about its tip; a fit takes every stride-th
+        # (``radii_near``)
+        self.stride = stride
+        self.shells = [np.unique(np.round(self.dist[self.own == k], 12)) for k in range(self.n)]
         self.square = grid // s.n_side  # points along an asperity's square
         overlap = np.maximum(last + self.z_tip, 0.0)
         shape = shape_constant(torch.as_tensor(design.gamma), s.radius).numpy()
@@ -237,7 +239,7 @@ class DiscCell:
             return True
 
     def family(self, k: int, j: int) -> tuple[float, float, float, float]:
-        """Disc j (the j-th fitted radius) of asperity k alone in the cell: (a [length],
+        """Disc j (the j-th distinct radius) of asperity k alone in the cell: (a [length],
         F_0k, k_k, M2_k) [E* length^2, E* length, E* length^3]."""
         key = (k, j)
         got = self.cache.get(key)
@@ -261,8 +263,13 @@ class DiscCell:
         return out
 
     def radii_near(self, k: int, centre: float) -> np.ndarray:
-        """Indices of asperity k's fitted radii within ``WINDOW`` spacings of ``centre``."""
-        return np.flatnonzero(np.abs(self.shells[k] - centre) < WINDOW * self.dx)
+        """Indices of asperity k's radii to fit within ``WINDOW`` spacings of ``centre``."""
+        near = np.flatnonzero(np.abs(self.shells[k] - centre) < WINDOW * self.dx)
+        every = near[near % self.stride == 0]
+        # a contact a few spacings wide has few distinct radii about its edge: all of them,
+        # where every stride-th would leave fewer than MIN_FIT (on a coarse grid a third of
+        # the states went unplaced without it)
+        return every if every.size >= MIN_FIT else near
 
     def prefill(self, ranges: dict[int, tuple[float, float]], done: threading.Event) -> int:
         """Solve the families of asperities ``ranges`` (k: (lo, hi) radii [length]) ahead of
@@ -271,7 +278,9 @@ class DiscCell:
         count = 0
         for k, (lo, hi) in ranges.items():
             reach = WINDOW * self.dx
-            for j in np.flatnonzero((self.shells[k] > lo - reach) & (self.shells[k] < hi + reach)):
+            shells = self.shells[k]
+            wanted = np.flatnonzero((shells > lo - reach) & (shells < hi + reach))
+            for j in wanted[wanted % self.stride == 0]:
                 if done.is_set() or stop_asked():
                     return count
                 if (k, int(j)) not in self.cache:

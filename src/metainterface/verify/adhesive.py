@@ -18,20 +18,33 @@ and the target (interpolated) are compared there with the adhesionless check's m
 over the states inside the target's range. Only the torch engine has a JKR-limit solver:
 the check runs there whatever ``Verify.engine`` says (a note says so).
 
-The check bounds its own error (issue 52). The JKR-limit BEM places a contact edge to a
-fraction of a grid spacing, so its area error falls with the grid: on a Hertz asperity
-against JKR's closed form 7.3 % at 128^2, 3.8 % at 128^2 loading only, 2.6 % at 256^2,
-1.3 % at 512^2 (``benchmarks/results/adhesion.md``), and pointwise of either sign (where
-an edge falls between grid points). Its own error on a grid M is estimated from the same
-check on M / 2 (``accuracy``): the two curves' difference over the target's norm, divided
-by 2^p - 1, p = 1 (``ORDER``). With errors of either sign that halve with the spacing the
-difference is about twice the fine grid's error, so the estimate bounds it: on a Hertz
-asperity against JKR, 14 % estimated against 6.2 % true at 64^2, 6.2 % against 2.9 % at
-128^2 (``tests/verify/test_adhesive_bound.py`` checks it there and against a finer grid).
-That holds up to ``adhesive_path.FINEST`` (256) points per asperity, the finest grid the
-check takes: past it the criterion's pinning of each edge (a share of K_c, not of the grid
-spacing) outweighs the pixel error, the error against JKR stops falling (with strong
-adhesion it grows) and two grids differ by less than either's error
+The check bounds its own error (issue 52). By default it finds each contact edge by the
+disc criterion (``validation.adhesive_discs``: each JKR edge from a family of bonded
+discs), whose error against JKR falls as the grid spacing with one sign, on three grids
+along the same approaches: the finer two extrapolated to zero spacing are its curve, and
+the difference to the coarser two's extrapolation is its own error (``accuracy``;
+``verify.adhesive_discs``). On a Hertz asperity against the JKR closed form the curve is
+within 0.12-0.21 % and the estimate 0.22-0.34 % (w = 4.2e-5 to 5e-4 E* R); on held-out
+9-asperity cells against the same criterion a grid finer, see
+``benchmarks/bench_adhesive_disc_check.py`` (benchmarks/results/adhesion.md). Without a
+grid given the finest grid starts at ``GRID_START`` points per asperity and doubles, up to
+``GRID_MAX``, while the estimate is above ``BOUND_SHARE`` of ``Verify.max_error`` or the
+criterion cannot place more than a quarter of the states (contacts a few spacings wide).
+
+Where a grid given is too coarse for it (a quarter of it under ``COARSEST`` points an
+asperity), or the criterion does not apply (an edge not found in its asperity's square),
+the check is the point-by-point JKR-limit BEM's, and a note says so. That BEM places a
+contact edge to a fraction of a grid spacing, so its area error falls with the grid: on a
+Hertz asperity against JKR's closed form 7.3 % at 128^2, 3.8 % at 128^2 loading only,
+2.6 % at 256^2, 1.3 % at 512^2 (``benchmarks/results/adhesion.md``), and pointwise of
+either sign (where an edge falls between grid points). Its own error on a grid M is
+estimated from the same check on M / 2 (``accuracy``): the two curves' difference over the
+target's norm, divided by 2^p - 1, p = 1 (``ORDER``). With errors of either sign that
+halve with the spacing the difference is about twice the fine grid's error, so the
+estimate bounds it: on a Hertz asperity against JKR, 14 % estimated against 6.2 % true at
+64^2, 6.2 % against 2.9 % at 128^2 (``tests/verify/test_adhesive_bound.py``). That holds
+up to ``adhesive_path.FINEST`` (256) points per asperity: past it the criterion's pinning
+of each edge (a share of K_c, not of the grid spacing) outweighs the pixel error
 (``benchmarks/bench_adhesive_convergence.py``).
 
 A cell of several asperities jumps where each snaps in, and a state at a jump reads either
@@ -42,7 +55,8 @@ piece between its snap-ins, never across one (``read_across_jumps``). Without th
 single state at a jump could put the check off a finer grid by several times the estimate
 (``benchmarks/bench_adhesive_check_bound.py``, figures in ``benchmarks/results/adhesion.md``).
 
-Without a grid given, the check starts at ``GRID_START`` points per asperity and doubles,
+Point by point and without a grid given, the check starts at ``GRID_START`` points per
+asperity and doubles,
 the last fine grid now the coarse one, while that estimate is above ``BOUND_SHARE`` of
 ``Verify.max_error`` and would fall below it by ``GRID_MAX`` per asperity at the assumed
 order (a doubling that cannot reach the bound only costs time: the check

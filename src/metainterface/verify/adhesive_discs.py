@@ -47,18 +47,17 @@ from metainterface.verify._adhesive_curve import AdhesiveSolved, read_across_jum
 #: few radii for the family's fit.
 COARSEST = 32
 #: The order assumed of what the first-order extrapolation leaves: the difference of two
-#: extrapolations is then 2^2 - 1 = 3 times the finer one's error. Measured on the example
-#: cell (w = 1e-4 E* R, 20 approaches) against the extrapolation from 384^2 and 768^2, the
-#: extrapolations from (96^2, 192^2) and (192^2, 384^2) are off by 0.65 % and 0.06 %: a
-#: ratio of 10, so the estimate (0.23 %) holds the finer one's error with room
-#: (benchmarks/results/adhesion.md).
+#: extrapolations is then 2^2 - 1 = 3 times the finer one's error. On the example cell and
+#: six held-out cells (w = 4.2e-5 and 2e-4 E* R), the estimate below was 1.4-8.7 times the
+#: check's difference to the same criterion a grid finer (extrapolated from 384^2 and
+#: 768^2): ``benchmarks/bench_adhesive_disc_check.py``, benchmarks/results/adhesion.md.
 RESIDUAL_ORDER = 2.0
 #: Added to that estimate: the scatter of the fits themselves, which no grid takes away in
 #: a foreseeable way (where the windows fall on the staircase of distinct radii). The
 #: extrapolated alpha moves by up to 0.07 % between fitting every third radius and every
-#: one, and a Hertz asperity's extrapolation from 256^2 and 512^2 is off JKR by up to
-#: 0.12 % (rms) where the difference of its two extrapolations reads 0.05 %
-#: (benchmarks/results/adhesion.md).
+#: one (``bench_adhesive_subpixel.py --path 10 --stride``), and without it a Hertz
+#: asperity at w = 5e-4 E* R reads 0.18 % off JKR where the difference of the
+#: extrapolations over 3 reads 0.13 % (``bench_adhesive_disc_check.py --hertz``).
 FIT_SCATTER = 1e-3
 
 
