@@ -246,3 +246,34 @@ def test_adhesive_bem_check_on_cuda_matches_cpu():
     np.testing.assert_allclose(gpu.p_star, cpu.p_star, rtol=1e-6)
     np.testing.assert_allclose(gpu.alpha_bem, cpu.alpha_bem, atol=2 / 48**2)
     assert gpu.bem_error == pytest.approx(cpu.bem_error, abs=5e-3)
+
+
+def test_adhesive_disc_check_on_cuda_matches_cpu():
+    """The default adhesive check (the disc criterion over three grids) reads the same curve
+    and error estimate on CUDA as on the CPU: its families and coupled solves are float64
+    conjugate gradients to 1e-9 and 1e-10, its edges fits of their sums."""
+    from metainterface.physics import CellSettings
+
+    s, w = CellSettings(), 0.05 / (2.4e6 * 0.5e-3)  # PDMS on glass at R = 0.5 mm
+    rng = np.random.default_rng(5)
+    g, h = rng.uniform(1.8, 4.0, 9), rng.uniform(0, 0.6, 9) * s.delta_max
+    design = mi.Design(gamma=g, h=h - h.min(), settings=s)
+    model = mi.Independent(adhesion=w)
+    with torch.no_grad():
+        gt, ht = design.tensors(torch.float64)
+        top = 0.9 * float(model.sweep(gt, ht, s).p_star[0, -1])
+        p = np.linspace(1e-12 * top, top, 16)
+        a = model.alpha_at_loads(gt, ht, s, torch.as_tensor(p)[None])[0].numpy()
+    target = mi.Target(p_star=p, alpha=a, name="sticky")
+    from metainterface.verify import bem_check
+
+    checks = {
+        dev: bem_check(design, target, mi.Verify(loads=6, correct=False, device=dev), model)
+        for dev in ("cpu", "cuda")
+    }
+    cpu, gpu = checks["cpu"], checks["cuda"]
+    assert gpu.device.startswith("cuda") and cpu.device == "cpu"
+    assert any("family of bonded discs" in n for n in gpu.notes)
+    np.testing.assert_allclose(gpu.p_star, cpu.p_star, rtol=1e-5)
+    np.testing.assert_allclose(gpu.alpha_bem, cpu.alpha_bem, rtol=1e-5)
+    assert gpu.accuracy == pytest.approx(cpu.accuracy, rel=1e-3)

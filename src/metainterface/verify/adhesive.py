@@ -24,8 +24,8 @@ discs), whose error against JKR falls as the grid spacing with one sign, on thre
 along the same approaches: the finer two extrapolated to zero spacing are its curve, and
 the difference to the coarser two's extrapolation is its own error (``accuracy``;
 ``verify.adhesive_discs``). On a Hertz asperity against the JKR closed form the curve is
-within 0.12-0.21 % and the estimate 0.22-0.34 % (w = 4.2e-5 to 5e-4 E* R); on held-out
-9-asperity cells against the same criterion a grid finer, see
+within 0.12-0.21 % and the estimate 0.23-0.34 % (w = 4.2e-5 to 5e-4 E* R); on ten
+9-asperity cells against the same criterion a grid finer, 0.02-0.10 % and 0.13-0.31 %, see
 ``benchmarks/bench_adhesive_disc_check.py`` (benchmarks/results/adhesion.md). Without a
 grid given the finest grid starts at ``GRID_START`` points per asperity and doubles, up to
 ``GRID_MAX``, while the estimate is above ``BOUND_SHARE`` of ``Verify.max_error`` or the

@@ -48,7 +48,7 @@ from metainterface.verify._adhesive_curve import AdhesiveSolved, read_across_jum
 COARSEST = 32
 #: The order assumed of what the first-order extrapolation leaves: the difference of two
 #: extrapolations is then 2^2 - 1 = 3 times the finer one's error. On the example cell and
-#: six held-out cells (w = 4.2e-5 and 2e-4 E* R), the estimate below was 1.4-8.7 times the
+#: nine held-out cells (w = 4.2e-5 to 5e-4 E* R), the estimate below was 1.4-7.1 times the
 #: check's difference to the same criterion a grid finer (extrapolated from 384^2 and
 #: 768^2): ``benchmarks/bench_adhesive_disc_check.py``, benchmarks/results/adhesion.md.
 RESIDUAL_ORDER = 2.0
