@@ -97,13 +97,11 @@ def cells(seeds: list[int], works: list[float]) -> None:
             target = own_curve(design, model)
             paths: dict = {}
             start = time.perf_counter()
-            check, acc, _ = disc_check(
+            check, acc = disc_check(
                 design, target, model, grids=(96, 192, 384), loads=10, known=paths
             )
             mid = time.perf_counter()
-            ref, _, _ = disc_check(
-                design, target, model, grids=(192, 384, 768), loads=10, known=paths
-            )
+            ref, _ = disc_check(design, target, model, grids=(192, 384, 768), loads=10, known=paths)
             end = time.perf_counter()
             other = read_across_jumps(check.p_star, ref.p_star, ref.alpha_bem, ref.snap_ins)
             seen = np.isfinite(other)

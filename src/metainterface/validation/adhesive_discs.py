@@ -49,6 +49,7 @@ from metainterface._threads import stop_asked
 from metainterface.errors import MetainterfaceError
 from metainterface.physics.cell import Design
 from metainterface.physics.sneddon import shape_constant
+from metainterface.validation._disc_windows import padded, window_kernels
 from metainterface.validation.adhesive_bem import (
     PRECONDITIONER_DTYPE,
     _apply,
@@ -82,36 +83,6 @@ MOVES = 40
 class DiscCriterionError(MetainterfaceError):
     """The disc criterion does not apply to this cell (an edge not found in its asperity's
     square, or a contact reaching the square's side)."""
-
-
-def _padded(m: int) -> int:
-    """The side of a window holding m x m points of a linear convolution: at least 2m - 1,
-    with no prime factor above 5 (an FFT of 236 = 4 x 59 points took 3x one of 240)."""
-    n = 2 * m
-    while True:
-        k = n
-        for q in (2, 3, 5):
-            while k % q == 0:
-                k //= q
-        if k == 1:
-            return n
-        n += 2
-
-
-def _window_kernels(kernel: torch.Tensor, grid: int, m: int, spacing: float):
-    """The compliance of a window of P x P points (``_padded``; the cell's real-space
-    kernel ``kernel`` (grid, grid) cut to offsets below m, zero-padded: a linear
-    convolution over m x m points) and the window's preconditioner, as ``_bonded`` takes
-    them."""
-    pad = _padded(m)
-    cut = torch.zeros(pad, pad, dtype=torch.float64, device=kernel.device)
-    near = np.r_[0:m, pad - m + 1 : pad]
-    src = np.r_[0:m, grid - m + 1 : grid]
-    cut[np.ix_(near, near)] = kernel[np.ix_(src, src)]
-    return (
-        _spectral(torch.fft.rfft2(cut)[None], torch.complex128),
-        _spectral(inverse_kernel(pad, pad * spacing, cut.device), PRECONDITIONER_DTYPE),
-    )
 
 
 def _pair(
@@ -174,17 +145,16 @@ class DiscCell:
         self.stride = stride
         self.shells = [np.unique(np.round(self.dist[self.own == k], 12)) for k in range(self.n)]
         self.square = grid // s.n_side  # points along an asperity's square
-        overlap = np.maximum(last + self.z_tip, 0.0)
-        shape = shape_constant(torch.as_tensor(design.gamma), s.radius).numpy()
-        radius = (overlap / shape) ** (1.0 / design.gamma)  # z = -(h + c_k r^gamma)
+        self._shape = shape_constant(torch.as_tensor(design.gamma), s.radius).numpy()
+        self._gamma = np.asarray(design.gamma, dtype=np.float64)
+        radius = self.overlap_radius(np.arange(self.n), last)
         reach = np.ceil(1.5 * radius / self.dx + WINDOW + 3).astype(int)
         self.m = [min(self.square, 2 * int(r)) + 2 for r in reach]
-        self._shape = shape
-        self._gamma = np.asarray(design.gamma, dtype=np.float64)
         dev = self.device
         self.fwd = _spectral(forward_kernel(grid, self.side, dev), torch.complex128)
         self.stiff = _spectral(inverse_kernel(grid, self.side, dev), PRECONDITIONER_DTYPE)
         self.z = torch.as_tensor(self.heights, device=dev)
+        self.own_t = torch.as_tensor(self.own, device=dev)
         self.kernel = torch.fft.irfft2(
             forward_kernel(grid, self.side, dev)[0].to(torch.complex128), s=(grid, grid)
         )
@@ -202,12 +172,12 @@ class DiscCell:
             if k not in self._windows:
                 m, grid = self.m[k], self.grid
                 if m not in self._kernels:
-                    self._kernels[m] = _window_kernels(self.kernel, grid, m, self.dx)
+                    self._kernels[m] = window_kernels(self.kernel, grid, m, self.dx)
                 cy, cx = divmod(int(self.tips[k]), grid)
                 rows, cols = np.ix_(
                     (np.arange(m) + cy - m // 2) % grid, (np.arange(m) + cx - m // 2) % grid
                 )
-                pad = _padded(m)
+                pad = padded(m)
                 zw, dw = np.zeros((pad, pad)), np.full((pad, pad), np.inf)
                 mine = np.zeros((pad, pad), dtype=bool)
                 block = self.dist[rows, cols]
@@ -292,7 +262,7 @@ class DiscCell:
         """(len(k),) the rigid overlap's radius [length] of asperities k at approach c: a
         first guess of a new contact's edge (adhesion holds it wider)."""
         overlap = np.maximum(c + self.z_tip[k], 0.0)
-        return (overlap / self._shape[k]) ** (1.0 / self._gamma[k])
+        return (overlap / self._shape[k]) ** (1.0 / self._gamma[k])  # z = -(h + c_k r^gamma)
 
     def coupled(self, c: float, rho: np.ndarray, touching: np.ndarray) -> torch.Tensor:
         """(2, M, M) the touching discs (radii ``rho`` (N,)) bonded together, at zero and
@@ -322,8 +292,7 @@ class DiscCell:
         for _ in range(ROUNDS):
             pair = self.coupled(c, rho, touching)
             pressure = pair[0] + c * pair[1]
-            own = torch.as_tensor(self.own, device=self.device)
-            others = torch.stack([pressure * (own != k) for k in touching])
+            others = torch.stack([pressure * (self.own_t != k) for k in touching])
             u_ext = _apply(others, self.fwd).cpu().numpy()
             edge, force = rho.copy(), 0.0
             for i, k in enumerate(touching):

@@ -396,10 +396,27 @@ def rising_branch(
     seconds = time.perf_counter() - t0
     assert path.touching is not None  # owner given
     snaps = own_snap_ins(path.p_star, path.touching)
-    keep = (
-        path.on_branch
-        & clear_of_snap_ins(path.p_star, path.touching, model.touch_loads(design))
-        & ~at_snap_ins(path.p_star, snaps)
-        & (path.p_star <= top * (1 + 1e-9))
+    keep = compared_states(
+        path.p_star, path.on_branch, path.touching, model.touch_loads(design), snaps, top
     )
     return RisingBranch(path, keep, snaps, deltas, str(dev), seconds)
+
+
+def compared_states(
+    p_star: np.ndarray,
+    on_branch: np.ndarray,
+    touching: np.ndarray,
+    peaks: np.ndarray,
+    snap_ins: np.ndarray,
+    top: float,
+) -> np.ndarray:
+    """(K,) bool: the states of a path (P* (K,), asperities in contact (K, N)) an adhesive
+    check compares: on the rising-force branch (``on_branch`` (K,)), clear of the model's
+    snap-ins (``peaks`` (N,), ``clear_of_snap_ins``) and of the path's own (``snap_ins``
+    (J, 2), ``at_snap_ins``), at most the load ``top`` asked up to."""
+    return (
+        on_branch
+        & clear_of_snap_ins(p_star, touching, peaks)
+        & ~at_snap_ins(p_star, snap_ins)
+        & (p_star <= top * (1 + 1e-9))
+    )

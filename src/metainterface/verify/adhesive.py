@@ -71,10 +71,8 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
-import torch
 
 from metainterface._threads import in_background, uses_threads
-from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
@@ -88,7 +86,13 @@ from metainterface.validation.adhesive_path import (  # noqa: F401  (re-exported
     clear_of_snap_ins,
     rising_branch,
 )
-from metainterface.verify._adhesive_curve import AdhesiveSolved, read_across_jumps
+from metainterface.verify._adhesive_curve import (
+    AdhesiveSolved,
+    inside_target,
+    model_alpha,
+    path_notes,
+    read_across_jumps,
+)
 from metainterface.verify.adhesive_discs import COARSEST, disc_check
 
 #: Grid points per lattice cell side of the default adhesive check's first fine grid (the
@@ -125,36 +129,22 @@ def solve_adhesive(
         design, model, grid=grid, samples=APPROACHES_PER_LOAD * loads, top=top, device=device
     )
     path, deltas, seconds, dev = branch.path, branch.approaches, branch.seconds, branch.device
-    # inside the target's range only: below its first row np.interp would hold the target
-    # at that row's alpha, an error the target does not state
-    inside = (path.p_star >= target.p_star[0] * (1 - 1e-9)) & (
-        path.p_star <= target.p_star_max * (1 + 1e-9)
-    )
-    keep = branch.keep & inside
-    if not keep.any():
-        raise MetainterfaceError(
-            "the adhesive BEM reached no load inside the target's range on its rising branch "
-            f"(up to P* = {float(path.p_star.max()):.3g}); check on a finer grid"
-        )
+    keep = inside_target(path.p_star, branch.keep, target, "the adhesive BEM")
     p = path.p_star[keep]
-    gamma, h = design.tensors(torch.float64)
-    with torch.no_grad():
-        mod = model.alpha_at_loads(gamma, h, design.settings, torch.as_tensor(p)[None])[0]
-    mod = mod.numpy()
-    notes = [
+    notes = (
         f"adhesive BEM: the JKR limit (Pohrt-Popov criterion) under a rising force, "
         f"w = {model.adhesion:.3g} E* R, {int(keep.sum())} of {deltas.size} approaches on "
-        "the rising branch"
-    ]
-    if engine != "torch":
-        notes.append(f"the adhesive check runs in the torch engine, not {engine}")
-    if p[-1] < top * (1 - 0.25):
-        notes.append(
-            f"the adhesive BEM's rising branch reaches P* = {p[-1]:.4g} in the target's "
-            f"range, short of {top:.4g}: the check stops there"
-        )
+        "the rising branch",
+        *path_notes(float(p[-1]), top, engine),
+    )
     return AdhesiveSolved(
-        p, path.alpha[keep], mod, str(dev), seconds, tuple(notes), branch.snap_ins
+        p,
+        path.alpha[keep],
+        model_alpha(design, model, p),
+        str(dev),
+        seconds,
+        notes,
+        branch.snap_ins,
     )
 
 
@@ -210,15 +200,6 @@ def bounded_check(
 
     s = design.settings
     n = s.n_side
-
-    def solve(m: int) -> AdhesiveSolved:
-        return solve_adhesive(
-            design, target, model, grid=m, loads=loads, device=device, engine=engine
-        )
-
-    def half(m: int) -> int:  # a multiple of n, at least 8 points an asperity
-        return max(8 * n, (m // 2) // n * n)
-
     start = time.perf_counter()
     fine_grid = GRID_START * n if grid is None else check_grid(grid, s)
     bound = BOUND_SHARE * max_error
@@ -227,17 +208,67 @@ def bounded_check(
         f"quarter of it, must be a multiple of {n} with at least {COARSEST} points an "
         "asperity): the check is the point-by-point BEM's"
     )
+    checked = None
     if fine_grid // 4 >= COARSEST * n and fine_grid % (4 * n) == 0:
         try:
-            return _bounded_discs(
-                design, target, model, fine_grid, grid is None, loads, max_error, device, start
+            checked = _bounded_discs(
+                design, target, model, fine_grid, grid is None, loads, bound, device, engine
             )
+            fallback = None
         except DiscCriterionError as exc:
             fallback = (
                 f"the disc criterion does not apply to this design ({exc}): the check is the "
                 "point-by-point BEM's"
             )
-    coarse_grid = half(fine_grid)
+    if checked is None:
+        checked = _bounded_points(
+            design, target, model, fine_grid, grid is None, loads, bound, device, engine
+        )
+    solved, fine_grid, acc, grids, source, beyond = checked
+    note = f"the adhesive check's own error, {source}: {100 * acc:.2g} %" + (
+        f" (within a quarter of the {100 * max_error:g} % asked)"
+        if acc <= bound
+        else f", above a quarter of the {100 * max_error:g} % asked{beyond}: its verdict holds "
+        "to that"
+    )
+    notes = (*solved.notes, note) + ((fallback,) if fallback else ())
+    if model.adhesion > VALIDATED_WORK:
+        notes += (
+            f"w = {model.adhesion:.3g} E* R is above the {VALIDATED_WORK:g} E* R up to which "
+            "the check's own error estimate was shown to hold against JKR",
+        )
+    solved = replace(solved, notes=notes)
+    return BoundedCheck(solved, fine_grid, acc, grids, time.perf_counter() - start)
+
+
+#: What a way of checking hands ``bounded_check``: the solve at the grid it settled on, that
+#: grid, its own error, the grids solved, where the error came from (for the note), and what
+#: the note adds where that error stays above the bound.
+_Checked = tuple[AdhesiveSolved, int, float, tuple[int, ...], str, str]
+
+
+def _bounded_points(
+    design: Design,
+    target: Target,
+    model: ForwardModel,
+    fine_grid: int,
+    auto: bool,
+    loads: int,
+    bound: float,
+    device: str,
+    engine: str,
+) -> _Checked:
+    """``bounded_check`` point by point: on fine_grid and half of it; where ``auto``,
+    doubling while the two-grid estimate is above ``bound`` and would fall below it by
+    ``GRID_MAX`` n at the assumed order."""
+    n = design.settings.n_side
+
+    def solve(m: int) -> AdhesiveSolved:
+        return solve_adhesive(
+            design, target, model, grid=m, loads=loads, device=device, engine=engine
+        )
+
+    coarse_grid = max(8 * n, (fine_grid // 2) // n * n)  # a multiple of n, >= 8 an asperity
     # The two grids at once, on two Python threads (each one torch thread; a solve's FFTs
     # and CG steps release the GIL), each path in two chains (``rising_branch``): on two
     # cores, or beside busy processes, the check takes about half the fine path's time
@@ -251,31 +282,15 @@ def bounded_check(
     def worth(m: int) -> bool:  # the bound within reach by GRID_MAX at the assumed order
         return acc * (m / (GRID_MAX * n)) ** ORDER <= bound and 2 * m <= GRID_MAX * n
 
-    while grid is None and acc > bound and worth(fine_grid):
+    while auto and acc > bound and worth(fine_grid):
         coarse, coarse_grid = fine, fine_grid
         fine_grid = 2 * fine_grid
         fine = solve(fine_grid)
         grids.append(fine_grid)
         acc = accuracy(fine, coarse, target)
-    note = (
-        f"the adhesive check's own error, from {coarse_grid}^2 and {fine_grid}^2: "
-        f"{100 * acc:.2g} %"
-        + (
-            f" (within a quarter of the {100 * max_error:g} % asked)"
-            if acc <= bound
-            else f", above a quarter of the {100 * max_error:g} % asked"
-            + ("" if grid is not None else f" (a finer grid, to {GRID_MAX} n, would not reach it)")
-            + ": its verdict holds to that"
-        )
-    )
-    notes = (*fine.notes, note) + ((fallback,) if fallback else ())
-    if model.adhesion > VALIDATED_WORK:
-        notes += (
-            f"w = {model.adhesion:.3g} E* R is above the {VALIDATED_WORK:g} E* R up to which "
-            "the check's own error estimate was shown to hold against JKR",
-        )
-    fine = replace(fine, notes=notes)
-    return BoundedCheck(fine, fine_grid, acc, tuple(grids), time.perf_counter() - start)
+    beyond = f" (a finer grid, to {GRID_MAX} n, would not reach it)" if auto else ""
+    source = f"from {coarse_grid}^2 and {fine_grid}^2"
+    return fine, fine_grid, acc, tuple(grids), source, beyond
 
 
 def _bounded_discs(
@@ -285,33 +300,31 @@ def _bounded_discs(
     fine_grid: int,
     auto: bool,
     loads: int,
-    max_error: float,
+    bound: float,
     device: str,
-    start: float,
-) -> BoundedCheck:
+    engine: str,
+) -> _Checked:
     """``bounded_check`` by the disc criterion (``verify.adhesive_discs``): on fine_grid /
-    4, / 2 and fine_grid; where ``auto``, doubled while its own error is above the bound or
-    the criterion finds no edge on the coarsest grid (a contact a few spacings wide), up to
+    4, / 2 and fine_grid; where ``auto``, doubled while its own error is above ``bound`` or
+    the criterion cannot place the states (a contact a few spacings wide), up to
     ``GRID_MAX`` n. The paths of grids already solved are reused."""
     n = design.settings.n_side
-    bound = BOUND_SHARE * max_error
 
     def grids(m: int) -> tuple[int, int, int]:
         return (m // 4, m // 2, m)
 
     paths: dict = {}
-    tried: list[int] = []
     while True:
-        tried.append(fine_grid)
         finer = auto and 2 * fine_grid <= GRID_MAX * n
         try:
-            solved, acc, _ = disc_check(
+            solved, acc = disc_check(
                 design,
                 target,
                 model,
                 grids=grids(fine_grid),
                 loads=loads,
                 device=device,
+                engine=engine,
                 known=paths,
             )
         except DiscCriterionError:
@@ -323,20 +336,5 @@ def _bounded_discs(
             break
         fine_grid *= 2
     g = grids(fine_grid)
-    note = (
-        f"the adhesive check's own error, from the extrapolations of ({g[0]}^2, {g[1]}^2) and "
-        f"({g[1]}^2, {g[2]}^2): {100 * acc:.2g} %"
-        + (
-            f" (within a quarter of the {100 * max_error:g} % asked)"
-            if acc <= bound
-            else f", above a quarter of the {100 * max_error:g} % asked: its verdict holds to that"
-        )
-    )
-    notes = (*solved.notes, note)
-    if model.adhesion > VALIDATED_WORK:
-        notes += (
-            f"w = {model.adhesion:.3g} E* R is above the {VALIDATED_WORK:g} E* R up to which "
-            "the check's own error estimate was shown to hold against JKR",
-        )
-    solved = replace(solved, notes=notes)
-    return BoundedCheck(solved, fine_grid, acc, tuple(sorted(paths)), time.perf_counter() - start)
+    source = f"from the extrapolations of ({g[0]}^2, {g[1]}^2) and ({g[1]}^2, {g[2]}^2)"
+    return solved, fine_grid, acc, tuple(sorted(paths)), source, ""

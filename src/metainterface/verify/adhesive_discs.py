@@ -25,10 +25,8 @@ import threading
 import time
 
 import numpy as np
-import torch
 
 from metainterface._threads import in_background
-from metainterface.errors import MetainterfaceError
 from metainterface.inverse.targets import Target
 from metainterface.physics.cell import Design
 from metainterface.physics.models import ForwardModel
@@ -37,11 +35,16 @@ from metainterface.validation.adhesive_path import (
     APPROACHES_PER_LOAD,
     AdhesivePath,
     approaches,
-    at_snap_ins,
-    clear_of_snap_ins,
+    compared_states,
     own_snap_ins,
 )
-from metainterface.verify._adhesive_curve import AdhesiveSolved, read_across_jumps
+from metainterface.verify._adhesive_curve import (
+    AdhesiveSolved,
+    inside_target,
+    model_alpha,
+    path_notes,
+    read_across_jumps,
+)
 
 #: Points per asperity at least of the check's coarsest grid: below it a contact spans too
 #: few radii for the family's fit.
@@ -74,12 +77,10 @@ def _extrapolated(fine: AdhesivePath, coarse: AdhesivePath) -> tuple[np.ndarray,
     return p, a, same, fine.touching[:k]
 
 
-def _curve(
-    fine: AdhesivePath, coarse: AdhesivePath, design: Design, model: ForwardModel, top: float
-):
-    """The extrapolated load-controlled curve: (P*, alpha) (K,), keep (K,) bool (the states
-    a rising force reaches, clear of the model's and its own snap-ins, at most ``top``,
-    both grids touching alike) and its snap-ins (J, 2)."""
+def _curve(fine: AdhesivePath, coarse: AdhesivePath, peaks: np.ndarray, top: float):
+    """The extrapolated load-controlled curve: (P*, alpha) (K,), keep (K,) bool (both grids
+    touching alike, and ``compared_states``: the model's snap-ins ``peaks`` (N,), at most
+    ``top``) and its snap-ins (J, 2)."""
     p, a, same, touching = _extrapolated(fine, coarse)
     running = np.maximum.accumulate(np.where(same, p, -np.inf))
     # the snap-ins from every state, those left out read between their neighbours
@@ -88,15 +89,8 @@ def _curve(
         raise DiscCriterionError("the disc criterion placed no state of the path")
     at = np.arange(p.size)
     snaps = own_snap_ins(np.interp(at, at[placed], p[placed]), touching)
-    keep = (
-        same
-        & (p >= running)
-        & (p > 0)
-        & clear_of_snap_ins(p, touching, model.touch_loads(design))
-        & ~at_snap_ins(p, snaps)
-        & (p <= top * (1 + 1e-9))
-    )
-    return p, a, keep, snaps
+    on_branch = same & (p >= running) & (p > 0)
+    return p, a, compared_states(p, on_branch, touching, peaks, snaps, top), snaps
 
 
 def disc_check(
@@ -107,13 +101,14 @@ def disc_check(
     grids: tuple[int, int, int],
     loads: int,
     device: str = "auto",
+    engine: str = "torch",
     known: dict[int, AdhesivePath] | None = None,
-):
+) -> tuple[AdhesiveSolved, float]:
     """``design`` in the disc criterion on ``grids`` (M / 4, M / 2, M): the curve from the
     finer two extrapolated, at the states a rising force reaches inside the target's range,
-    and its own error from the coarser two. ``known``: paths already solved (by grid) along
-    the same approaches, taken as they are; the paths solved here are added to it. Returns
-    (AdhesiveSolved, accuracy, seconds).
+    and its own error from the coarser two. ``engine``: the one asked for (noted when it is
+    not torch). ``known``: paths already solved (by grid) along the same approaches, taken
+    as they are; the paths solved here are added to it. Returns (AdhesiveSolved, accuracy).
     Raises DiscCriterionError where the criterion does not apply, MetainterfaceError where
     no state lies in the target's range or a solve does not converge."""
     from metainterface._device import resolve_device
@@ -162,15 +157,10 @@ def disc_check(
             f"the disc criterion could not place {unplaced} of {k} states on {grids[1]}^2 "
             f"and {grids[2]}^2 (contacts a few spacings wide)"
         )
-    p, a, keep, snaps = _curve(finest, middle, design, model, top)
-    inside = (p >= target.p_star[0] * (1 - 1e-9)) & (p <= target.p_star_max * (1 + 1e-9))
-    keep &= inside
-    if not keep.any():
-        raise MetainterfaceError(
-            "the adhesive check (disc criterion) reached no load inside the target's range on "
-            f"its rising branch (up to P* = {float(np.nanmax(p, initial=0.0)):.3g})"
-        )
-    lp, la, lkeep, lsnaps = _curve(middle, coarsest, design, model, top)
+    peaks = model.touch_loads(design)
+    p, a, keep, snaps = _curve(finest, middle, peaks, top)
+    keep = inside_target(p, keep, target, "the adhesive check (disc criterion)")
+    lp, la, lkeep, lsnaps = _curve(middle, coarsest, peaks, top)
     other = (
         read_across_jumps(p[keep], lp[lkeep], la[lkeep], lsnaps)
         if lkeep.sum() >= 2
@@ -184,27 +174,26 @@ def disc_check(
         if read.sum() >= max(2, keep.sum() / 2) and norm > 0
         else math.inf
     )
-    gamma, h = design.tensors(torch.float64)
-    with torch.no_grad():
-        mod = model.alpha_at_loads(gamma, h, s, torch.as_tensor(p[keep])[None])[0].numpy()
     m = [g // s.n_side for g in grids]
-    notes = [
+    notes = (
         f"adhesive BEM: the JKR limit, each edge from a family of bonded discs, "
         f"w = {model.adhesion:.3g} E* R, extrapolated to zero spacing from {grids[1]}^2 and "
         f"{grids[2]}^2 ({m[1]} and {m[2]} points an asperity); {int(keep.sum())} of "
         f"{deltas.size} approaches on the rising branch",
-    ]
-    if unplaced:
-        notes.append(
-            f"{unplaced} of {k} approaches left out: an asperity's contact there is too few "
-            "spacings wide for the disc criterion on these grids (just after it touched)"
-        )
-    if p[keep][-1] < top * (1 - 0.25):
-        notes.append(
-            f"the adhesive BEM's rising branch reaches P* = {p[keep][-1]:.4g} in the target's "
-            f"range, short of {top:.4g}: the check stops there"
-        )
-    solved = AdhesiveSolved(
-        p[keep], a[keep], mod, str(dev), time.perf_counter() - start, tuple(notes), snaps
     )
-    return solved, acc, time.perf_counter() - start
+    if unplaced:
+        notes += (
+            f"{unplaced} of {k} approaches left out: an asperity's contact there is too few "
+            "spacings wide for the disc criterion on these grids (just after it touched)",
+        )
+    notes += path_notes(float(p[keep][-1]), top, engine)
+    solved = AdhesiveSolved(
+        p[keep],
+        a[keep],
+        model_alpha(design, model, p[keep]),
+        str(dev),
+        time.perf_counter() - start,
+        notes,
+        snaps,
+    )
+    return solved, acc
