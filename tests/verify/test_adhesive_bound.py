@@ -343,3 +343,20 @@ def test_the_check_reads_the_target_only_inside_its_rows(hertz):
         design, target, mi.Independent(adhesion=W), grid=64, loads=10, max_error=0.02
     ).solved
     assert s.p_star.size >= 2 and s.p_star.min() >= target.p_star[0]
+
+
+def test_the_disc_check_says_it_ran_in_torch_when_another_engine_was_asked(hertz):
+    # only the torch engine has a JKR-limit solver: a check asked of tamaas runs there and
+    # says so, by the disc criterion as point by point
+    design, target = hertz
+    b = bounded_check(
+        design,
+        target,
+        mi.Independent(adhesion=W),
+        grid=None,
+        loads=4,
+        max_error=0.02,
+        engine="tamaas",
+    )
+    assert any("family of bonded discs" in n for n in b.solved.notes)
+    assert any("runs in the torch engine, not tamaas" in n for n in b.solved.notes)
